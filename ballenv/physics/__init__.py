@@ -1,0 +1,14 @@
+"""The inflated-ring simulator: pure numerics (NumPy + numba), no gymnasium, no torch."""
+
+from .scene import Ring, Scene
+from .simulate import SimulationError, SimulationStats, Trajectory, energy, simulate
+
+__all__ = [
+    "Ring",
+    "Scene",
+    "SimulationError",
+    "SimulationStats",
+    "Trajectory",
+    "energy",
+    "simulate",
+]

@@ -1,0 +1,181 @@
+"""Stretching and bending of a closed discrete elastic rod (a ring), with exact Jacobians.
+
+Nodes ``x`` (N, 2) in metres, counter-clockwise; edge ``e_i = x_{i+1} - x_i`` (indices mod N).
+
+Stretching, per edge::
+
+    E_s = 1/2 EA eps^2 l0,   eps = |e| / l0 - 1                      [J per metre of width * b]
+
+Bending, per node, with the turning angle ``phi_i`` between edges ``e_{i-1}`` and ``e_i``::
+
+    E_b = 1/2 (EI / l0) (phi_i - phi0)^2,   phi0 = 2 pi / N (the circle)
+
+``EA = E b h`` (N) and ``EI = E b h^3 / 12`` (N m^2). Forces are ``F = -dE/dx`` (N); Jacobian kernels
+add ``coef * dF/dx`` (N/m) into a band matrix (see :mod:`ballenv.physics.linalg`).
+"""
+
+import math
+
+from numba import njit
+
+from .cyclic import next_node, prev_node
+from .linalg import band_add_block
+
+
+@njit(cache=True)
+def stretch_energy(x, rest_len, ea):
+    """Stretching energy (J) of the ring."""
+    n = x.shape[0]
+    e = 0.0
+    for i in range(n):
+        j = next_node(i, n)
+        dx = x[j, 0] - x[i, 0]
+        dy = x[j, 1] - x[i, 1]
+        eps = math.sqrt(dx * dx + dy * dy) / rest_len - 1.0
+        e += 0.5 * ea * eps * eps * rest_len
+    return e
+
+
+@njit(cache=True)
+def stretch_force(x, rest_len, ea, f):
+    """Add the stretching forces (N) to ``f`` (N, 2)."""
+    n = x.shape[0]
+    for i in range(n):
+        j = next_node(i, n)
+        dx = x[j, 0] - x[i, 0]
+        dy = x[j, 1] - x[i, 1]
+        length = math.sqrt(dx * dx + dy * dy)
+        eps = length / rest_len - 1.0
+        s = ea * eps / length
+        f[i, 0] += s * dx
+        f[i, 1] += s * dy
+        f[j, 0] -= s * dx
+        f[j, 1] -= s * dy
+
+
+@njit(cache=True)
+def stretch_jacobian(x, rest_len, ea, coef, band, pos):
+    """Add ``coef * dF_s/dx`` to ``band``.
+
+    With ``u = e/|e|``, the Hessian of ``E_s`` in ``e`` is ``H = EA [u u^T / l0 + eps (I - u u^T)/|e|]``;
+    ``dF_i/dx_i = dF_j/dx_j = -H`` and ``dF_i/dx_j = dF_j/dx_i = H``.
+    """
+    n = x.shape[0]
+    for i in range(n):
+        j = next_node(i, n)
+        dx = x[j, 0] - x[i, 0]
+        dy = x[j, 1] - x[i, 1]
+        length = math.sqrt(dx * dx + dy * dy)
+        eps = length / rest_len - 1.0
+        ux = dx / length
+        uy = dy / length
+        a = ea / rest_len
+        b = ea * eps / length
+        h00 = coef * (a * ux * ux + b * (1.0 - ux * ux))
+        h01 = coef * (a * ux * uy - b * ux * uy)
+        h11 = coef * (a * uy * uy + b * (1.0 - uy * uy))
+        band_add_block(band, pos, i, i, -h00, -h01, -h01, -h11)
+        band_add_block(band, pos, j, j, -h00, -h01, -h01, -h11)
+        band_add_block(band, pos, i, j, h00, h01, h01, h11)
+        band_add_block(band, pos, j, i, h00, h01, h01, h11)
+
+
+@njit(cache=True)
+def _turning_angle(x, i, n):
+    p = prev_node(i, n)
+    q = next_node(i, n)
+    e1x = x[i, 0] - x[p, 0]
+    e1y = x[i, 1] - x[p, 1]
+    e2x = x[q, 0] - x[i, 0]
+    e2y = x[q, 1] - x[i, 1]
+    return math.atan2(e1x * e2y - e1y * e2x, e1x * e2x + e1y * e2y), e1x, e1y, e2x, e2y
+
+
+@njit(cache=True)
+def bend_energy(x, rest_len, ei, rest_turn):
+    """Bending energy (J) of the ring."""
+    n = x.shape[0]
+    k = ei / rest_len
+    e = 0.0
+    for i in range(n):
+        phi = _turning_angle(x, i, n)[0]
+        e += 0.5 * k * (phi - rest_turn) ** 2
+    return e
+
+
+@njit(cache=True)
+def bend_force(x, rest_len, ei, rest_turn, f):
+    """Add the bending forces (N) to ``f``.
+
+    ``dphi/dx_{i-1} = g(e1)``, ``dphi/dx_i = -g(e1) - g(e2)``, ``dphi/dx_{i+1} = g(e2)`` with
+    ``g(e) = (-e_y, e_x) / |e|^2`` the gradient of the edge's direction angle.
+    """
+    n = x.shape[0]
+    k = ei / rest_len
+    for i in range(n):
+        phi, e1x, e1y, e2x, e2y = _turning_angle(x, i, n)
+        s1 = e1x * e1x + e1y * e1y
+        s2 = e2x * e2x + e2y * e2y
+        g1x, g1y = -e1y / s1, e1x / s1
+        g2x, g2y = -e2y / s2, e2x / s2
+        m = -k * (phi - rest_turn)
+        p = prev_node(i, n)
+        q = next_node(i, n)
+        f[p, 0] += m * g1x
+        f[p, 1] += m * g1y
+        f[i, 0] -= m * (g1x + g2x)
+        f[i, 1] -= m * (g1y + g2y)
+        f[q, 0] += m * g2x
+        f[q, 1] += m * g2y
+
+
+@njit(cache=True)
+def bend_jacobian(x, rest_len, ei, rest_turn, coef, band, pos):
+    """Add ``coef * dF_b/dx = -coef k [grad phi grad phi^T + (phi - phi0) hess phi]`` to ``band``.
+
+    The Hessian of the edge angle is ``H(e) = [[2 ex ey, ey^2 - ex^2], [ey^2 - ex^2, -2 ex ey]] / |e|^4``;
+    ``hess phi`` has blocks (prev, prev) = -H1, (prev, i) = H1, (i, i) = H2 - H1, (i, next) = -H2,
+    (next, next) = H2.
+    """
+    n = x.shape[0]
+    k = ei / rest_len
+    for i in range(n):
+        phi, e1x, e1y, e2x, e2y = _turning_angle(x, i, n)
+        s1 = e1x * e1x + e1y * e1y
+        s2 = e2x * e2x + e2y * e2y
+        # gradient blocks: node a in (prev, i, next)
+        gpx, gpy = -e1y / s1, e1x / s1
+        gnx, gny = -e2y / s2, e2x / s2
+        gix, giy = -gpx - gnx, -gpy - gny
+        c = -coef * k
+        t = phi - rest_turn
+        a1 = 2.0 * e1x * e1y / (s1 * s1)
+        b1 = (e1y * e1y - e1x * e1x) / (s1 * s1)
+        a2 = 2.0 * e2x * e2y / (s2 * s2)
+        b2 = (e2y * e2y - e2x * e2x) / (s2 * s2)
+        p = prev_node(i, n)
+        q = next_node(i, n)
+        _bend_block(band, pos, p, p, c, t, gpx, gpy, gpx, gpy, -a1, -b1)
+        _bend_block(band, pos, p, i, c, t, gpx, gpy, gix, giy, a1, b1)
+        _bend_block(band, pos, i, p, c, t, gix, giy, gpx, gpy, a1, b1)
+        _bend_block(band, pos, i, i, c, t, gix, giy, gix, giy, a2 - a1, b2 - b1)
+        _bend_block(band, pos, i, q, c, t, gix, giy, gnx, gny, -a2, -b2)
+        _bend_block(band, pos, q, i, c, t, gnx, gny, gix, giy, -a2, -b2)
+        _bend_block(band, pos, q, q, c, t, gnx, gny, gnx, gny, a2, b2)
+        _bend_block(band, pos, p, q, c, t, gpx, gpy, gnx, gny, 0.0, 0.0)
+        _bend_block(band, pos, q, p, c, t, gnx, gny, gpx, gpy, 0.0, 0.0)
+
+
+@njit(cache=True)
+def _bend_block(band, pos, a, b, c, t, gax, gay, gbx, gby, ha, hb):
+    """Add ``c (g_a g_b^T + t [[ha, hb], [hb, -ha]])`` at node block (a, b)."""
+    band_add_block(
+        band,
+        pos,
+        a,
+        b,
+        c * (gax * gbx + t * ha),
+        c * (gax * gby + t * hb),
+        c * (gay * gbx + t * hb),
+        c * (gay * gby - t * ha),
+    )

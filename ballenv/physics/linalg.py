@@ -1,0 +1,189 @@
+"""O(N) linear solve of a ring's Newton system.
+
+The Jacobian of a ring with ``N`` nodes is a ``2N x 2N`` matrix whose node blocks (2x2) couple a node
+with its two neighbours on each side *cyclically* (stretching couples i, i+1; bending couples i-1,
+i, i+1). Renumbering the nodes in the zig-zag order ``0, N-1, 1, N-2, 2, ...`` puts every ring
+neighbour within four positions, so the cyclic band becomes a plain band of half-width
+``BAND_HALF_WIDTH = 2 * 4 + 1 = 9`` degrees of freedom. The band is factorised by LU without
+pivoting (the matrix is dominated by the positive mass term ``M / (beta dt^2)``; a vanishing pivot is
+reported and the step is rejected).
+
+The dense but low-rank terms (the pressure's ``dp/dA`` term, rank 1; the damping's coupling to the
+rigid-body motion, rank 3) are kept exactly with the Woodbury identity::
+
+    (B + U V^T)^-1 r = y - Z (I + V^T Z)^-1 V^T y,   y = B^-1 r,  Z = B^-1 U.
+
+Band storage: ``band[row, BAND_HALF_WIDTH + col - row] = A[row, col]`` in zig-zag DOF order; vectors
+passed to the solver are in natural DOF order (``2 * node + component``).
+"""
+
+import numpy as np
+from numba import njit
+
+BAND_HALF_WIDTH = 9
+BAND_COLUMNS = 2 * BAND_HALF_WIDTH + 1
+MAX_LOW_RANK = 4
+
+
+def zigzag_positions(n_nodes):
+    """Position of each node in the zig-zag order 0, N-1, 1, N-2, ... -> int64 array (N,)."""
+    order = np.empty(n_nodes, dtype=np.int64)
+    lo, hi = 0, n_nodes - 1
+    for k in range(n_nodes):
+        if k % 2 == 0:
+            order[k] = lo
+            lo += 1
+        else:
+            order[k] = hi
+            hi -= 1
+    pos = np.empty(n_nodes, dtype=np.int64)
+    pos[order] = np.arange(n_nodes)
+    return pos
+
+
+@njit(cache=True)
+def band_add_block(band, pos, i, j, a00, a01, a10, a11):
+    """Add the 2x2 block [[a00, a01], [a10, a11]] at node row ``i``, node column ``j``."""
+    r = 2 * pos[i]
+    c = 2 * pos[j]
+    w = BAND_HALF_WIDTH
+    band[r, w + c - r] += a00
+    band[r, w + c + 1 - r] += a01
+    band[r + 1, w + c - r - 1] += a10
+    band[r + 1, w + c - r] += a11
+
+
+@njit(cache=True, fastmath=True)
+def band_lu(band):
+    """Factorise a band matrix in place (LU, no pivoting). Returns False on a zero/non-finite pivot."""
+    n = band.shape[0]
+    w = BAND_HALF_WIDTH
+    for k in range(n):
+        row_k = band[k]
+        pivot = row_k[w]
+        if not (abs(pivot) > 1e-300) or not np.isfinite(pivot):
+            return False
+        inv = 1.0 / pivot
+        last = min(n - 1, k + w)
+        count = last - k
+        for i in range(k + 1, last + 1):
+            row_i = band[i]
+            off = w + k - i
+            lik = row_i[off] * inv
+            row_i[off] = lik
+            for j in range(count):
+                row_i[off + 1 + j] -= lik * row_k[w + 1 + j]
+    return True
+
+
+@njit(cache=True, fastmath=True)
+def band_lu_solve(lu, b):
+    """Solve (L U) X = B in place for a factor from :func:`band_lu`; ``b`` is (n, k), band order."""
+    n = lu.shape[0]
+    w = BAND_HALF_WIDTH
+    k = b.shape[1]
+    for i in range(n):
+        row = lu[i]
+        bi = b[i]
+        for j in range(max(0, i - w), i):
+            lij = row[w + j - i]
+            bj = b[j]
+            for c in range(k):
+                bi[c] -= lij * bj[c]
+    for i in range(n - 1, -1, -1):
+        row = lu[i]
+        bi = b[i]
+        for j in range(i + 1, min(n, i + w + 1)):
+            uij = row[w + j - i]
+            bj = b[j]
+            for c in range(k):
+                bi[c] -= uij * bj[c]
+        inv = 1.0 / row[w]
+        for c in range(k):
+            bi[c] *= inv
+
+
+@njit(cache=True)
+def _small_solve(a, b, k):
+    """Solve a[:k, :k] y = b[:k] in place (Gaussian elimination, partial pivoting). False if singular."""
+    for c in range(k):
+        best = c
+        for r in range(c + 1, k):
+            if abs(a[r, c]) > abs(a[best, c]):
+                best = r
+        if not (abs(a[best, c]) > 1e-300):
+            return False
+        if best != c:
+            for j in range(k):
+                a[c, j], a[best, j] = a[best, j], a[c, j]
+            b[c], b[best] = b[best], b[c]
+        for r in range(c + 1, k):
+            f = a[r, c] / a[c, c]
+            for j in range(c, k):
+                a[r, j] -= f * a[c, j]
+            b[r] -= f * b[c]
+    for r in range(k - 1, -1, -1):
+        s = b[r]
+        for j in range(r + 1, k):
+            s -= a[r, j] * b[j]
+        b[r] = s / a[r, r]
+    return True
+
+
+@njit(cache=True)
+def solve_band_low_rank(band, pos, u, v, rank, rhs, work, cap, coef):
+    """Solve (B + U V^T) x = rhs in place, O(N).
+
+    ``band`` holds B (band order) and is overwritten by its LU factor; ``u``, ``v`` are (2N, >=rank)
+    in natural order; ``rhs`` (2N,) natural order is overwritten by the solution. ``work``
+    (2N, 1 + MAX_LOW_RANK), ``cap`` (MAX_LOW_RANK, MAX_LOW_RANK) and ``coef`` (MAX_LOW_RANK,) are
+    scratch. Returns False if the factorisation breaks down.
+    """
+    if not band_lu(band):
+        return False
+    n_nodes = pos.shape[0]
+    cols = work[:, : rank + 1]
+    for node in range(n_nodes):
+        p = 2 * pos[node]
+        for d in range(2):
+            cols[p + d, 0] = rhs[2 * node + d]
+            for c in range(rank):
+                cols[p + d, c + 1] = u[2 * node + d, c]
+    band_lu_solve(band, cols)
+    if rank > 0:
+        for a in range(rank):
+            s = 0.0
+            for c in range(rank):
+                cap[a, c] = 1.0 if a == c else 0.0
+            for node in range(n_nodes):
+                p = 2 * pos[node]
+                for d in range(2):
+                    va = v[2 * node + d, a]
+                    s += va * cols[p + d, 0]
+                    for c in range(rank):
+                        cap[a, c] += va * cols[p + d, c + 1]
+            coef[a] = s
+        if not _small_solve(cap, coef, rank):
+            return False
+    for node in range(n_nodes):
+        p = 2 * pos[node]
+        for d in range(2):
+            s = cols[p + d, 0]
+            for c in range(rank):
+                s -= cols[p + d, c + 1] * coef[c]
+            rhs[2 * node + d] = s
+    return True
+
+
+def band_to_dense(band, pos):
+    """Dense 2N x 2N matrix (natural DOF order) of a band in zig-zag order; for tests and checks."""
+    n = band.shape[0]
+    w = BAND_HALF_WIDTH
+    dense_band_order = np.zeros((n, n))
+    for r in range(n):
+        for c in range(max(0, r - w), min(n, r + w + 1)):
+            dense_band_order[r, c] = band[r, w + c - r]
+    dof = np.empty(n, dtype=np.int64)
+    dof[0::2] = 2 * pos
+    dof[1::2] = 2 * pos + 1
+    return dense_band_order[np.ix_(dof, dof)]

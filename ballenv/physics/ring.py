@@ -1,0 +1,65 @@
+"""Geometry and material of one ring -> rest lengths, node masses, stiffnesses, initial nodes.
+
+A ring of ``N`` nodes on a circle of radius ``R`` (m): a regular polygon, stress-free. Wall thickness
+``h`` (m), out-of-plane width ``b`` (m), Young's modulus ``E`` (Pa), density ``rho`` (kg/m^3)::
+
+    l0   = 2 R sin(pi / N)         rest edge length (m)
+    phi0 = 2 pi / N                rest turning angle at each node (rad)
+    EA   = E b h                   stretching stiffness (N)
+    EI   = E b h^3 / 12            bending stiffness (N m^2)
+    m    = rho b h l0              node mass (kg): the polygon's length shared equally
+    A0   = N R^2 sin(2 pi / N) / 2 rest area of the polygon (m^2)
+
+With this mass the discrete ring's breathing mode has exactly the continuum frequency
+``sqrt(E / rho) / R`` for any ``N``.
+"""
+
+import math
+
+import numpy as np
+
+
+def rest_edge_length(radius, n_nodes):
+    """``l0 = 2 R sin(pi / N)`` (m)."""
+    return 2.0 * radius * math.sin(math.pi / n_nodes)
+
+
+def rest_turning_angle(n_nodes):
+    """``phi0 = 2 pi / N`` (rad)."""
+    return 2.0 * math.pi / n_nodes
+
+
+def rest_area(radius, n_nodes):
+    """Area of the regular N-gon inscribed in the circle (m^2)."""
+    return 0.5 * n_nodes * radius**2 * math.sin(2.0 * math.pi / n_nodes)
+
+
+def stretching_stiffness(ring):
+    """``EA = E b h`` (N)."""
+    return ring.youngs_modulus * ring.width * ring.thickness
+
+
+def bending_stiffness(ring):
+    """``EI = E b h^3 / 12`` (N m^2)."""
+    return ring.youngs_modulus * ring.width * ring.thickness**3 / 12.0
+
+
+def node_mass(ring):
+    """``m = rho b h l0`` (kg)."""
+    return ring.density * ring.width * ring.thickness * rest_edge_length(ring.radius, ring.n_nodes)
+
+
+def total_mass(ring):
+    """Mass of the whole ring (kg)."""
+    return ring.n_nodes * node_mass(ring)
+
+
+def initial_nodes(ring):
+    """Node positions (N, 2) m and velocities (N, 2) m/s of the ring's initial rigid motion."""
+    theta = 2.0 * np.pi * np.arange(ring.n_nodes) / ring.n_nodes
+    offset = ring.radius * np.stack([np.cos(theta), np.sin(theta)], axis=1)
+    x = offset + np.asarray(ring.position, dtype=float)
+    v = np.empty_like(x)
+    v[:, 0] = ring.velocity[0] - ring.angular_velocity * offset[:, 1]
+    v[:, 1] = ring.velocity[1] + ring.angular_velocity * offset[:, 0]
+    return x, v

@@ -1,0 +1,223 @@
+"""Ring and Scene descriptions, validated on construction (SI units).
+
+Every field is checked when the object is made; a bad value raises ``ValueError`` naming the field,
+the value and the valid range, e.g.::
+
+    ValueError: Ring.youngs_modulus = -1.0 is out of range: must be a finite number in (0, 1e+12] Pa
+"""
+
+import math
+from dataclasses import dataclass, field
+from numbers import Integral, Real
+
+INTEGRATORS = ("backward_euler", "generalized_alpha")
+DAMPING_MODES = ("rigid", "centre_of_mass")
+CONTACT_METHODS = ("mass_modification", "predictor_corrector")
+
+
+def _fail(owner, name, value, valid):
+    raise ValueError(f"{owner}.{name} = {value!r} is out of range: must be {valid}")
+
+
+def check_real(owner, name, value, low, high, unit="", low_open=False, high_open=False):
+    """Return ``value`` as float if it is a finite real within the interval, else raise ValueError."""
+    lo_br = "(" if low_open else "["
+    hi_br = ")" if high_open else "]"
+    valid = f"a finite number in {lo_br}{low:g}, {high:g}{hi_br}" + (f" {unit}" if unit else "")
+    if isinstance(value, bool) or not isinstance(value, Real):
+        _fail(owner, name, value, valid)
+    v = float(value)
+    if not math.isfinite(v):
+        _fail(owner, name, value, valid)
+    if v < low or v > high or (low_open and v == low) or (high_open and v == high):
+        _fail(owner, name, value, valid)
+    return v
+
+
+def check_int(owner, name, value, low, high):
+    """Return ``value`` as int if it is an integer within [low, high], else raise ValueError."""
+    if isinstance(value, bool) or not isinstance(value, Integral) or not low <= value <= high:
+        _fail(owner, name, value, f"an integer in [{low}, {high}]")
+    return int(value)
+
+
+def check_vector(owner, name, value, bound, unit):
+    """Return ``value`` as a tuple of two finite floats with magnitude at most ``bound``."""
+    valid = f"a pair of finite numbers in [-{bound:g}, {bound:g}] {unit}"
+    try:
+        items = tuple(value)
+    except TypeError:
+        _fail(owner, name, value, valid)
+    if len(items) != 2:
+        _fail(owner, name, value, valid)
+    out = []
+    for item in items:
+        if isinstance(item, bool) or not isinstance(item, Real):
+            _fail(owner, name, value, valid)
+        f = float(item)
+        if not math.isfinite(f) or abs(f) > bound:
+            _fail(owner, name, value, valid)
+        out.append(f)
+    return tuple(out)
+
+
+def check_choice(owner, name, value, choices):
+    """Return ``value`` if it is one of ``choices``, else raise ValueError."""
+    if value not in choices:
+        _fail(owner, name, value, "one of " + ", ".join(repr(c) for c in choices))
+    return value
+
+
+@dataclass(frozen=True)
+class Ring:
+    """One inflated elastic ring (a 2-D ball).
+
+    Attributes:
+        radius: rest radius R of the centreline circle (m), in (0, 100].
+        n_nodes: number of nodes N, in [3, 4096].
+        youngs_modulus: E of the wall (Pa), in (0, 1e12].
+        thickness: wall thickness h (m), in (0, radius).
+        width: out-of-plane width b (m), in (0, 100].
+        density: wall density rho (kg/m^3), in (0, 1e5].
+        pressure: gauge pressure at the rest shape (Pa) in [0, 1e8], or None for no gas at all.
+        position: initial centre (m).
+        velocity: initial centre velocity (m/s), each component in [-1000, 1000].
+        angular_velocity: initial spin (rad/s, counter-clockwise), in [-1e5, 1e5].
+    """
+
+    radius: float = 0.1
+    n_nodes: int = 64
+    youngs_modulus: float = 10e6
+    thickness: float = 2e-3
+    width: float = 0.02
+    density: float = 1100.0
+    pressure: float | None = 30e3
+    position: tuple = (0.0, 1.0)
+    velocity: tuple = (0.0, 0.0)
+    angular_velocity: float = 0.0
+
+    def __post_init__(self):
+        o = "Ring"
+        s = object.__setattr__
+        s(self, "radius", check_real(o, "radius", self.radius, 0.0, 100.0, "m", low_open=True))
+        s(self, "n_nodes", check_int(o, "n_nodes", self.n_nodes, 3, 4096))
+        s(
+            self,
+            "youngs_modulus",
+            check_real(o, "youngs_modulus", self.youngs_modulus, 0.0, 1e12, "Pa", low_open=True),
+        )
+        s(
+            self,
+            "thickness",
+            check_real(o, "thickness", self.thickness, 0.0, self.radius, "m (below radius)", True, True),
+        )
+        s(self, "width", check_real(o, "width", self.width, 0.0, 100.0, "m", low_open=True))
+        s(self, "density", check_real(o, "density", self.density, 0.0, 1e5, "kg/m^3", True))
+        if self.pressure is not None:
+            s(self, "pressure", check_real(o, "pressure", self.pressure, 0.0, 1e8, "Pa (or None)"))
+        s(self, "position", check_vector(o, "position", self.position, 1e6, "m"))
+        s(self, "velocity", check_vector(o, "velocity", self.velocity, 1e3, "m/s"))
+        s(
+            self,
+            "angular_velocity",
+            check_real(o, "angular_velocity", self.angular_velocity, -1e5, 1e5, "rad/s"),
+        )
+
+
+@dataclass(frozen=True)
+class Scene:
+    """What to simulate: rings, the effects acting on them, and the numerical method.
+
+    Attributes:
+        rings: one or more :class:`Ring` (all with the same ``n_nodes``).
+        gravity: magnitude g (m/s^2) along -y, in [0, 1000]; or a vector (gx, gy). 0 turns it off.
+        damping: c (1/s) in [0, 1e6] of the deformation damping ``F_i = -c m (u_i - u_rigid,i)``.
+        damping_mode: "rigid" (relative to the rigid motion: flight and spin undamped) or
+            "centre_of_mass" (the paper's form, relative to the centre-of-mass velocity only).
+        integrator: "generalized_alpha" (second order, default) or "backward_euler" (first order).
+        rho_infinity: spectral radius at infinite frequency of generalized-alpha, in [0, 1]
+            (1 = no numerical damping, trapezoidal rule; 0 = strongest high-frequency damping).
+        dt: time step (s) in (0, 1]: the fixed step, or the largest step when adaptive.
+        adaptive: adapt the step: a step whose Newton iteration fails is rejected and retried with
+            half the step; accepted steps grow it cautiously (x1.25) back up to ``dt``.
+        dt_min: smallest step (s) before simulate() gives up with SimulationError, in (0, dt].
+        newton_tol: Newton tolerance on the residual relative to the forces it balances
+            (dimensionless), in [1e-14, 1e-2].
+        newton_max_iter: Newton iterations before the step is rejected, in [1, 200].
+        atmospheric_pressure: p_atm (Pa) in [0, 1e7]; 0 gives the paper's ``p A = const``.
+        gas_exponent: k in ``(p + p_atm) A^k = const`` in [1, 3] (1 isothermal, 1.4 adiabatic air).
+    """
+
+    rings: tuple = field(default_factory=lambda: (Ring(),))
+    gravity: float | tuple = 9.81
+    damping: float = 0.0
+    damping_mode: str = "rigid"
+    integrator: str = "generalized_alpha"
+    rho_infinity: float = 0.9
+    dt: float = 1e-4
+    adaptive: bool = False
+    dt_min: float = 1e-9
+    newton_tol: float = 1e-9
+    newton_max_iter: int = 25
+    atmospheric_pressure: float = 101325.0
+    gas_exponent: float = 1.0
+
+    def __post_init__(self):
+        o = "Scene"
+        s = object.__setattr__
+        rings = self.rings
+        if isinstance(rings, Ring):
+            rings = (rings,)
+        try:
+            rings = tuple(rings)
+        except TypeError:
+            _fail(o, "rings", self.rings, "a non-empty sequence of Ring")
+        if not rings or not all(isinstance(r, Ring) for r in rings):
+            _fail(o, "rings", self.rings, "a non-empty sequence of Ring")
+        if len({r.n_nodes for r in rings}) != 1:
+            _fail(o, "rings", [r.n_nodes for r in rings], "rings with equal n_nodes")
+        s(self, "rings", rings)
+        if isinstance(self.gravity, Real) and not isinstance(self.gravity, bool):
+            g = check_real(o, "gravity", self.gravity, 0.0, 1000.0, "m/s^2")
+            s(self, "gravity", g)
+        else:
+            s(self, "gravity", check_vector(o, "gravity", self.gravity, 1000.0, "m/s^2"))
+        s(self, "damping", check_real(o, "damping", self.damping, 0.0, 1e6, "1/s"))
+        s(self, "damping_mode", check_choice(o, "damping_mode", self.damping_mode, DAMPING_MODES))
+        s(self, "integrator", check_choice(o, "integrator", self.integrator, INTEGRATORS))
+        s(self, "rho_infinity", check_real(o, "rho_infinity", self.rho_infinity, 0.0, 1.0))
+        s(self, "dt", check_real(o, "dt", self.dt, 0.0, 1.0, "s", low_open=True))
+        if not isinstance(self.adaptive, bool):
+            _fail(o, "adaptive", self.adaptive, "True or False")
+        s(
+            self,
+            "dt_min",
+            check_real(o, "dt_min", self.dt_min, 0.0, self.dt, "s (at most dt)", True),
+        )
+        s(self, "newton_tol", check_real(o, "newton_tol", self.newton_tol, 1e-14, 1e-2))
+        s(self, "newton_max_iter", check_int(o, "newton_max_iter", self.newton_max_iter, 1, 200))
+        s(
+            self,
+            "atmospheric_pressure",
+            check_real(o, "atmospheric_pressure", self.atmospheric_pressure, 0.0, 1e7, "Pa"),
+        )
+        s(self, "gas_exponent", check_real(o, "gas_exponent", self.gas_exponent, 1.0, 3.0))
+
+    @property
+    def gravity_vector(self):
+        """Gravitational acceleration (gx, gy) in m/s^2."""
+        if isinstance(self.gravity, tuple):
+            return self.gravity
+        return (0.0, -self.gravity)
+
+    @property
+    def effects(self):
+        """Names of the effects this scene switches on (stretching and bending always are)."""
+        names = ["stretching", "bending"]
+        if any(r.pressure is not None for r in self.rings):
+            names.append("pressure")
+        if any(g != 0.0 for g in self.gravity_vector):
+            names.append("gravity")
+        if self.damping > 0.0:
+            names.append("damping")
+        return tuple(names)

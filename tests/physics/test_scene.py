@@ -1,0 +1,88 @@
+"""Ring and Scene validate every value on construction, naming the field, the value and the range."""
+
+import math
+
+import pytest
+
+from ballenv.physics import Ring, Scene, simulate
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "field"),
+    [
+        ({"youngs_modulus": -1.0}, "youngs_modulus"),
+        ({"youngs_modulus": math.nan}, "youngs_modulus"),
+        ({"n_nodes": 2}, "n_nodes"),
+        ({"n_nodes": 16.0}, "n_nodes"),
+        ({"thickness": 0.1}, "thickness"),
+        ({"thickness": 0.2}, "thickness"),
+        ({"radius": 0.0}, "radius"),
+        ({"radius": math.inf}, "radius"),
+        ({"density": -5.0}, "density"),
+        ({"width": 0.0}, "width"),
+        ({"pressure": -1.0}, "pressure"),
+        ({"pressure": math.nan}, "pressure"),
+        ({"position": (0.0, math.nan)}, "position"),
+        ({"position": (0.0, 1.0, 2.0)}, "position"),
+        ({"velocity": "fast"}, "velocity"),
+        ({"angular_velocity": math.inf}, "angular_velocity"),
+    ],
+)
+def test_ring_rejects_invalid_values(kwargs, field):
+    with pytest.raises(ValueError, match=rf"Ring\.{field} = .* must be"):
+        Ring(**kwargs)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "field"),
+    [
+        ({"rings": []}, "rings"),
+        ({"rings": [1.0]}, "rings"),
+        ({"rings": [Ring(n_nodes=8), Ring(n_nodes=16)]}, "rings"),
+        ({"gravity": -9.81}, "gravity"),
+        ({"gravity": (0.0, math.nan)}, "gravity"),
+        ({"damping": -1.0}, "damping"),
+        ({"damping_mode": "viscous"}, "damping_mode"),
+        ({"integrator": "rk4"}, "integrator"),
+        ({"rho_infinity": 1.5}, "rho_infinity"),
+        ({"dt": 0.0}, "dt"),
+        ({"dt": 1e-3, "dt_min": 1e-2}, "dt_min"),
+        ({"adaptive": 1}, "adaptive"),
+        ({"newton_tol": 0.5}, "newton_tol"),
+        ({"newton_max_iter": 0}, "newton_max_iter"),
+        ({"atmospheric_pressure": -1.0}, "atmospheric_pressure"),
+        ({"gas_exponent": 0.5}, "gas_exponent"),
+    ],
+)
+def test_scene_rejects_invalid_values(kwargs, field):
+    with pytest.raises(ValueError, match=rf"Scene\.{field} = .* must be"):
+        Scene(**kwargs)
+
+
+def test_error_message_names_value_and_range():
+    with pytest.raises(ValueError) as err:
+        Ring(youngs_modulus=-1.0)
+    assert str(err.value) == (
+        "Ring.youngs_modulus = -1.0 is out of range: must be a finite number in (0, 1e+12] Pa"
+    )
+
+
+@pytest.mark.parametrize("t_end", [0.0, -1.0, math.nan, "1"])
+def test_simulate_rejects_invalid_t_end(t_end):
+    with pytest.raises(ValueError, match=r"simulate\.t_end"):
+        simulate(Scene(), t_end)
+
+
+def test_simulate_rejects_wrong_initial_state_shape_and_nan():
+    scene = Scene(rings=[Ring(n_nodes=8)])
+    with pytest.raises(ValueError, match=r"simulate\.x0 has shape"):
+        simulate(scene, 0.01, x0=[[0.0, 0.0]])
+    with pytest.raises(ValueError, match=r"simulate\.v0 contains NaN"):
+        simulate(scene, 0.01, v0=[[math.nan, 0.0]] * 8)
+
+
+def test_effects_name_only_what_the_scene_asks_for():
+    bare = Scene(rings=[Ring(pressure=None)], gravity=0.0)
+    assert bare.effects == ("stretching", "bending")
+    full = Scene(rings=[Ring(pressure=0.0)], gravity=9.81, damping=1.0)
+    assert full.effects == ("stretching", "bending", "pressure", "gravity", "damping")
