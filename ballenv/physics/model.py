@@ -5,16 +5,22 @@ method, ``Workspace`` the scratch arrays of one ring's Newton solve. All are Nam
 arrays and scalars: numba compiles them as records, they pickle, and they hold nothing else.
 """
 
+import math
 from typing import NamedTuple
 
 import numpy as np
 
 from . import ring as ring_geometry
+from .elastic import stretch_energy
 from .linalg import BAND_COLUMNS, MAX_LOW_RANK, zigzag_positions
-from .loads import DAMPING_CENTRE_OF_MASS, DAMPING_NONE, DAMPING_RIGID
+from .loads import DAMPING_CENTRE_OF_MASS, DAMPING_NONE, DAMPING_RIGID, gas_energy
 
 METHOD_BACKWARD_EULER = 0
 METHOD_GENERALIZED_ALPHA = 1
+
+CONTACT_NONE = 0
+CONTACT_MASS_MODIFICATION = 1
+CONTACT_PREDICTOR_CORRECTOR = 2
 
 
 class Model(NamedTuple):
@@ -33,6 +39,11 @@ class Model(NamedTuple):
     use_gravity: bool
     damping: float  # 1/s
     damping_mode: int
+    grounds: np.ndarray  # (G, 4): normal x, normal y, offset d (m), friction coefficient
+    contact_method: int
+    friction_regularization: float  # m/s
+    impulse_tol: float  # N s
+    rest_energy: np.ndarray  # (R,) J: stretching + gas energy of the inflated circle at rest
 
 
 class Solver(NamedTuple):
@@ -62,6 +73,26 @@ class Workspace(NamedTuple):
     dx: np.ndarray  # (N, 2) displacement of the step, the Newton unknown
     xe: np.ndarray  # (N, 2)
     ve: np.ndarray  # (N, 2)
+    reaction: np.ndarray  # (N,) normal ground reaction of the last solve (N)
+    friction: np.ndarray  # (N,) friction force along the ground's tangent (N)
+    energy: np.ndarray  # (5,) energy parts (J)
+
+
+class State(NamedTuple):
+    x: np.ndarray  # (R, N, 2) m
+    v: np.ndarray  # (R, N, 2) m/s
+    a: np.ndarray  # (R, N, 2) m/s^2 (the generalized-alpha acceleration)
+    active: np.ndarray  # (R, N) int64: constraining ground of each node, or -1
+    contact_force: np.ndarray  # (R, N, 2) N
+
+
+class Recording(NamedTuple):
+    t: np.ndarray  # (T,)
+    x: np.ndarray  # (T, R, N, 2)
+    v: np.ndarray  # (T, R, N, 2)
+    pressure: np.ndarray  # (T, R)
+    contact_force: np.ndarray  # (T, R, N, 2)
+    events: np.ndarray  # (E, 4): t, ring, kind, centre-of-mass height
 
 
 def generalized_alpha_parameters(rho_infinity):
@@ -85,7 +116,7 @@ def build_model(scene):
     n = rings[0].n_nodes
     p_atm = scene.atmospheric_pressure
     k = scene.gas_exponent
-    area0 = np.array([ring_geometry.rest_area(r.radius, n) for r in rings])
+    area0 = np.array([ring_geometry.rest_area(ring_geometry.inflated_radius(r), n) for r in rings])
     pressurised = np.array([r.pressure is not None for r in rings])
     gauge = np.array([0.0 if r.pressure is None else r.pressure for r in rings])
     if scene.damping == 0.0:
@@ -111,7 +142,43 @@ def build_model(scene):
         use_gravity=bool(np.any(gravity != 0.0)),
         damping=float(scene.damping),
         damping_mode=mode,
+        grounds=ground_array(scene.grounds),
+        contact_method=(
+            CONTACT_NONE
+            if not scene.grounds
+            else CONTACT_MASS_MODIFICATION
+            if scene.contact == "mass_modification"
+            else CONTACT_PREDICTOR_CORRECTOR
+        ),
+        friction_regularization=float(scene.friction_regularization),
+        impulse_tol=float(scene.impulse_tol),
+        rest_energy=np.array([_rest_energy(r, p_atm, k) for r in rings]),
     )
+
+
+def _rest_energy(ring, atmospheric_pressure, gas_exponent):
+    """Stretching plus gas energy (J) of ``ring`` on its inflated circle: the floor of its potential
+    energy without gravity (a regular polygon has no bending energy)."""
+    r = ring_geometry.inflated_radius(ring)
+    n = ring.n_nodes
+    theta = 2.0 * np.pi * np.arange(n) / n
+    x = r * np.stack([np.cos(theta), np.sin(theta)], axis=1)
+    rest_len = ring_geometry.rest_edge_length(ring.radius, n)
+    out = stretch_energy(x, rest_len, ring_geometry.stretching_stiffness(ring))
+    if ring.pressure is not None:
+        area = ring_geometry.rest_area(r, n)
+        gas_constant = (ring.pressure + atmospheric_pressure) * area**gas_exponent
+        out += gas_energy(area, gas_constant, gas_exponent, atmospheric_pressure, ring.width)
+    return out
+
+
+def ground_array(grounds):
+    """(G, 4) rows ``(n_x, n_y, d, mu)``: half-plane ``n . x >= d``, ``n = (-sin a, cos a)``,
+    ``d = height cos a`` (the surface passes through (0, height))."""
+    out = np.zeros((len(grounds), 4))
+    for k, g in enumerate(grounds):
+        out[k] = (-math.sin(g.angle), math.cos(g.angle), g.height * math.cos(g.angle), g.friction)
+    return out
 
 
 def build_solver(scene):
@@ -154,4 +221,32 @@ def build_workspace(n_nodes):
         dx=np.zeros((n_nodes, 2)),
         xe=np.zeros((n_nodes, 2)),
         ve=np.zeros((n_nodes, 2)),
+        reaction=np.zeros(n_nodes),
+        friction=np.zeros(n_nodes),
+        energy=np.zeros(5),
+    )
+
+
+def empty_state(n_rings, n_nodes):
+    """A zeroed State with every node free."""
+    shape = (n_rings, n_nodes, 2)
+    return State(
+        x=np.zeros(shape),
+        v=np.zeros(shape),
+        a=np.zeros(shape),
+        active=np.full((n_rings, n_nodes), -1, dtype=np.int64),
+        contact_force=np.zeros(shape),
+    )
+
+
+def empty_recording(capacity, n_rings, n_nodes, event_capacity):
+    """Uninitialised output buffers for ``capacity`` records."""
+    shape = (capacity, n_rings, n_nodes, 2)
+    return Recording(
+        t=np.empty(capacity),
+        x=np.empty(shape),
+        v=np.empty(shape),
+        pressure=np.empty((capacity, n_rings)),
+        contact_force=np.empty(shape),
+        events=np.empty((event_capacity, 4)),
     )

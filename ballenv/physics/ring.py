@@ -12,6 +12,15 @@ A ring of ``N`` nodes on a circle of radius ``R`` (m): a regular polygon, stress
 
 With this mass the discrete ring's breathing mode has exactly the continuum frequency
 ``sqrt(E / rho) / R`` for any ``N``.
+
+A pressurised ring starts inflated: a regular polygon of radius ``r`` at which the hoop tension of
+the stretched wall balances the gauge pressure ``p`` it holds (``Ring.pressure``, what a gauge on the
+ball at rest reads). Per node, ``2 EA eps sin(pi/N) = p b r sin(2 pi/N)`` with ``eps = r / R - 1``::
+
+    EA (r / R - 1) = p b r cos(pi / N)   =>   r = R / (1 - q),   q = p b R cos(pi / N) / EA
+
+(the hoop tension ``T = p b r`` of a thin pressurised ring, up to the polygon's ``cos(pi/N)``); ``q``
+must stay below 1 (beyond, no wall tension can hold the gas).
 """
 
 import math
@@ -54,10 +63,28 @@ def total_mass(ring):
     return ring.n_nodes * node_mass(ring)
 
 
+def inflation_ratio(ring):
+    """``q = p b R cos(pi / N) / EA`` (dimensionless); 0 without gas. The inflated strain is q / (1 - q)."""
+    if not ring.pressure:
+        return 0.0
+    return (
+        ring.pressure
+        * ring.width
+        * ring.radius
+        * math.cos(math.pi / ring.n_nodes)
+        / (stretching_stiffness(ring))
+    )
+
+
+def inflated_radius(ring):
+    """Radius (m) of the ring's inflated equilibrium circle, ``R / (1 - q)``; ``R`` without gas."""
+    return ring.radius / (1.0 - inflation_ratio(ring))
+
+
 def initial_nodes(ring):
-    """Node positions (N, 2) m and velocities (N, 2) m/s of the ring's initial rigid motion."""
+    """Node positions (N, 2) m and velocities (N, 2) m/s: the inflated circle in rigid motion."""
     theta = 2.0 * np.pi * np.arange(ring.n_nodes) / ring.n_nodes
-    offset = ring.radius * np.stack([np.cos(theta), np.sin(theta)], axis=1)
+    offset = inflated_radius(ring) * np.stack([np.cos(theta), np.sin(theta)], axis=1)
     x = offset + np.asarray(ring.position, dtype=float)
     v = np.empty_like(x)
     v[:, 0] = ring.velocity[0] - ring.angular_velocity * offset[:, 1]

@@ -61,6 +61,19 @@ def check_vector(owner, name, value, bound, unit):
     return tuple(out)
 
 
+def check_sequence(owner, name, value, cls, allow_empty):
+    """Return ``value`` (one ``cls`` or a sequence of them) as a tuple, else raise ValueError."""
+    valid = f"a {'' if allow_empty else 'non-empty '}sequence of {cls.__name__}"
+    items = (value,) if isinstance(value, cls) else value
+    try:
+        items = tuple(items)
+    except TypeError:
+        _fail(owner, name, value, valid)
+    if (not items and not allow_empty) or not all(isinstance(item, cls) for item in items):
+        _fail(owner, name, value, valid)
+    return items
+
+
 def check_choice(owner, name, value, choices):
     """Return ``value`` if it is one of ``choices``, else raise ValueError."""
     if value not in choices:
@@ -79,7 +92,10 @@ class Ring:
         thickness: wall thickness h (m), in (0, radius).
         width: out-of-plane width b (m), in (0, 100].
         density: wall density rho (kg/m^3), in (0, 1e5].
-        pressure: gauge pressure at the rest shape (Pa) in [0, 1e8], or None for no gas at all.
+        pressure: gauge pressure (Pa) of the inflated ball at rest, in [0, min(1e8, E h / (2 R cos(pi/N)))],
+            or None for no gas at all. The ring starts inflated to the circle where its wall tension
+            holds this pressure (radius ``R / (1 - p b R cos(pi/N) / EA)``); the amount of gas is fixed
+            there and the gas law sets the pressure as the ring deforms.
         position: initial centre (m).
         velocity: initial centre velocity (m/s), each component in [-1000, 1000].
         angular_velocity: initial spin (rad/s, counter-clockwise), in [-1e5, 1e5].
@@ -114,7 +130,11 @@ class Ring:
         s(self, "width", check_real(o, "width", self.width, 0.0, 100.0, "m", low_open=True))
         s(self, "density", check_real(o, "density", self.density, 0.0, 1e5, "kg/m^3", True))
         if self.pressure is not None:
-            s(self, "pressure", check_real(o, "pressure", self.pressure, 0.0, 1e8, "Pa (or None)"))
+            # inflated strain q / (1 - q) with q = p R cos(pi/N) / (E h): at most 100 % (q <= 1/2)
+            cos = math.cos(math.pi / self.n_nodes)
+            burst = 0.5 * self.youngs_modulus * self.thickness / (self.radius * cos)
+            unit = "Pa (or None); the upper bound inflates the wall by 100 %"
+            s(self, "pressure", check_real(o, "pressure", self.pressure, 0.0, min(1e8, burst), unit))
         s(self, "position", check_vector(o, "position", self.position, 1e6, "m"))
         s(self, "velocity", check_vector(o, "velocity", self.velocity, 1e3, "m/s"))
         s(
@@ -125,11 +145,43 @@ class Ring:
 
 
 @dataclass(frozen=True)
+class Ground:
+    """A ground half-plane: flat (angle 0) or sloped.
+
+    Attributes:
+        angle: slope angle a (rad) in [-pi/2 + 0.01, pi/2 - 0.01]; the inward normal is
+            (-sin a, cos a): positive angles rise to the right.
+        height: y (m) of the surface at x = 0.
+        friction: Coulomb coefficient mu in [0, 10] (0: frictionless).
+    """
+
+    angle: float = 0.0
+    height: float = 0.0
+    friction: float = 0.0
+
+    def __post_init__(self):
+        o = "Ground"
+        s = object.__setattr__
+        lim = math.pi / 2 - 0.01
+        s(self, "angle", check_real(o, "angle", self.angle, -lim, lim, "rad"))
+        s(self, "height", check_real(o, "height", self.height, -1e6, 1e6, "m"))
+        s(self, "friction", check_real(o, "friction", self.friction, 0.0, 10.0))
+
+
+@dataclass(frozen=True)
 class Scene:
     """What to simulate: rings, the effects acting on them, and the numerical method.
 
     Attributes:
         rings: one or more :class:`Ring` (all with the same ``n_nodes``).
+        grounds: any number of :class:`Ground` half-planes (none: no contact work at all).
+        contact: "mass_modification" (Baraff-Witkin: the contact set is updated inside the Newton
+            iteration; the system keeps its size) or "predictor_corrector" (the paper's first
+            method: the whole step is recomputed after each change of the contact set).
+        impulse_tol: largest node reaction impulse per step ``f dt`` (N s) in (0, 10] when
+            ``adaptive``; larger steps are rejected and shrunk by the ratio.
+        friction_regularization: slip speed (m/s) in (0, 1] below which Coulomb friction is
+            smoothed, ``mu N v / sqrt(v^2 + eps^2)``.
         gravity: magnitude g (m/s^2) along -y, in [0, 1000]; or a vector (gx, gy). 0 turns it off.
         damping: c (1/s) in [0, 1e6] of the deformation damping ``F_i = -c m (u_i - u_rigid,i)``.
         damping_mode: "rigid" (relative to the rigid motion: flight and spin undamped) or
@@ -149,6 +201,10 @@ class Scene:
     """
 
     rings: tuple = field(default_factory=lambda: (Ring(),))
+    grounds: tuple = ()
+    contact: str = "mass_modification"
+    impulse_tol: float = 5e-3
+    friction_regularization: float = 1e-4
     gravity: float | tuple = 9.81
     damping: float = 0.0
     damping_mode: str = "rigid"
@@ -165,18 +221,18 @@ class Scene:
     def __post_init__(self):
         o = "Scene"
         s = object.__setattr__
-        rings = self.rings
-        if isinstance(rings, Ring):
-            rings = (rings,)
-        try:
-            rings = tuple(rings)
-        except TypeError:
-            _fail(o, "rings", self.rings, "a non-empty sequence of Ring")
-        if not rings or not all(isinstance(r, Ring) for r in rings):
-            _fail(o, "rings", self.rings, "a non-empty sequence of Ring")
+        rings = check_sequence(o, "rings", self.rings, Ring, allow_empty=False)
         if len({r.n_nodes for r in rings}) != 1:
             _fail(o, "rings", [r.n_nodes for r in rings], "rings with equal n_nodes")
         s(self, "rings", rings)
+        s(self, "grounds", check_sequence(o, "grounds", self.grounds, Ground, allow_empty=True))
+        s(self, "contact", check_choice(o, "contact", self.contact, CONTACT_METHODS))
+        s(self, "impulse_tol", check_real(o, "impulse_tol", self.impulse_tol, 0.0, 10.0, "N s", True))
+        s(
+            self,
+            "friction_regularization",
+            check_real(o, "friction_regularization", self.friction_regularization, 0.0, 1.0, "m/s", True),
+        )
         if isinstance(self.gravity, Real) and not isinstance(self.gravity, bool):
             g = check_real(o, "gravity", self.gravity, 0.0, 1000.0, "m/s^2")
             s(self, "gravity", g)
@@ -220,4 +276,8 @@ class Scene:
             names.append("gravity")
         if self.damping > 0.0:
             names.append("damping")
+        if self.grounds:
+            names.append("ground")
+            if any(g.friction > 0.0 for g in self.grounds):
+                names.append("friction")
         return tuple(names)

@@ -6,21 +6,32 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import ring as ring_geometry
-from .elastic import bend_energy, stretch_energy
-from .loads import gas_energy, gravity_energy, polygon_area
-from .model import METHOD_GENERALIZED_ALPHA, build_model, build_solver, build_workspace
+from .events import event_list
+from .model import (
+    METHOD_GENERALIZED_ALPHA,
+    build_model,
+    build_solver,
+    build_workspace,
+    empty_recording,
+    empty_state,
+)
 from .scene import Scene, check_real
 from .stepper import (
     CLOCK_H,
+    COUNT_EVENTS,
     COUNT_NEWTON,
+    COUNT_RECORDS,
     COUNT_REJECTED,
     COUNT_STEPS,
+    ENERGY_PARTS,
     N_COUNTERS,
     STATUS_BUFFER_FULL,
+    STATUS_IMPULSE_AT_DT_MIN,
     STATUS_STEP_TOO_SMALL,
+    _record,
     advance,
     initial_acceleration,
-    ring_pressure,
+    ring_energy,
 )
 
 
@@ -70,6 +81,16 @@ class Trajectory:
     events: list
     stats: SimulationStats
     scene: Scene = field(repr=False)
+    event_table: np.ndarray = field(default=None, repr=False)
+
+    def apexes(self, ring=0):
+        """(k, 2) array of (t (s), centre-of-mass height (m)) at the apexes of ``ring``,
+        interpolated inside the step (cubic Hermite), not sampled."""
+        rows = self.event_table
+        if rows is None or len(rows) == 0:
+            return np.zeros((0, 2))
+        sel = (rows[:, 1] == ring) & (rows[:, 2] == 2)
+        return rows[sel][:, [0, 3]]
 
     def centre_of_mass(self):
         """(T, n_rings, 2) centre of mass (m); nodes of a ring have equal mass."""
@@ -89,29 +110,14 @@ def energy(scene, x, v):
     x = np.asarray(x, dtype=float)
     v = np.asarray(v, dtype=float)
     lead = x.shape[:-2]
-    xs = x.reshape(-1, x.shape[-2], 2)
-    vs = v.reshape(-1, x.shape[-2], 2)
+    xs = np.ascontiguousarray(x.reshape(-1, x.shape[-2], 2))
+    vs = np.ascontiguousarray(v.reshape(-1, x.shape[-2], 2))
     n_rings = len(scene.rings)
-    parts = {k: np.zeros(xs.shape[0]) for k in ("kinetic", "stretching", "bending", "gas", "gravity")}
+    table = np.zeros((xs.shape[0], len(ENERGY_PARTS)))
     for k in range(xs.shape[0]):
-        r = k % n_rings
-        xk = xs[k]
-        m = model.node_mass[r]
-        parts["kinetic"][k] = 0.5 * m * float(np.sum(vs[k] ** 2))
-        parts["stretching"][k] = stretch_energy(xk, model.rest_len[r], model.ea[r])
-        parts["bending"][k] = bend_energy(xk, model.rest_len[r], model.ei[r], model.rest_turn[r])
-        if model.pressurised[r]:
-            parts["gas"][k] = gas_energy(
-                polygon_area(xk),
-                model.gas_constant[r],
-                model.gas_exponent,
-                model.atmospheric_pressure,
-                model.width[r],
-            )
-        if model.use_gravity:
-            parts["gravity"][k] = gravity_energy(xk, m, model.gravity)
-    out = {k: p.reshape(lead) for k, p in parts.items()}
-    out["total"] = sum(out[k] for k in parts)
+        ring_energy(model, k % n_rings, xs[k], vs[k], table[k])
+    out = {name: table[:, j].reshape(lead) for j, name in enumerate(ENERGY_PARTS)}
+    out["total"] = table.sum(axis=1).reshape(lead)
     return out
 
 
@@ -159,25 +165,20 @@ def simulate(scene, t_end, x0=None, v0=None, output_dt=None, progress=False):
     ws = build_workspace(n_nodes)
     shape = (n_rings, n_nodes, 2)
     x_init, v_init = initial_state(scene)
-    x = _check_state("x0", x0, shape) if x0 is not None else x_init
-    v = _check_state("v0", v0, shape) if v0 is not None else v_init
-    a = np.zeros(shape)
+    state = empty_state(n_rings, n_nodes)
+    state.x[:] = _check_state("x0", x0, shape) if x0 is not None else x_init
+    state.v[:] = _check_state("v0", v0, shape) if v0 is not None else v_init
+    _check_above_grounds(model.grounds, state.x)
     if solver.method == METHOD_GENERALIZED_ALPHA:
-        initial_acceleration(model, x, v, a, ws)
-    x1, v1, a1 = np.zeros(shape), np.zeros(shape), np.zeros(shape)
+        initial_acceleration(model, state.x, state.v, state.a, ws)
+    trial = empty_state(n_rings, n_nodes)
     clock = np.array([0.0, solver.dt])
     counters = np.zeros(N_COUNTERS, dtype=np.int64)
 
     capacity = 1 + (int(np.ceil(t_end / output_dt)) + 1 if output_dt else 1024)
-    out_t = np.empty(capacity)
-    out_x = np.empty((capacity,) + shape)
-    out_v = np.empty((capacity,) + shape)
-    out_p = np.empty((capacity, n_rings))
-    out_t[0] = 0.0
-    out_x[0] = x
-    out_v[0] = v
-    out_p[0] = [ring_pressure(model, r, x[r]) for r in range(n_rings)]
-    n_out = 1
+    rec = empty_recording(capacity, n_rings, n_nodes, 64 * n_rings)
+    _record(model, 0, 0.0, state, rec)
+    counters[COUNT_RECORDS] = 1
     bar = _progress_bar(t_end) if progress else None
     chunk = t_end / 100.0 if progress else t_end
     failure = None
@@ -185,19 +186,22 @@ def simulate(scene, t_end, x0=None, v0=None, output_dt=None, progress=False):
     while clock[0] < t_end:
         target = min(t_end, max(target, clock[0]) + chunk)
         while True:
-            status, n_out = advance(
-                model, solver, ws, x, v, a, x1, v1, a1, clock, counters, target, t_end,
-                0.0 if output_dt is None else output_dt, out_t, out_x, out_v, out_p, n_out,
+            status = advance(
+                model, solver, ws, state, trial, clock, counters, target, t_end,
+                0.0 if output_dt is None else output_dt, rec,
             )  # fmt: skip
             if status != STATUS_BUFFER_FULL:
                 break
-            grow = out_t.shape[0]
-            out_t = np.concatenate([out_t, np.empty(grow)])
-            out_x = np.concatenate([out_x, np.empty((grow,) + shape)])
-            out_v = np.concatenate([out_v, np.empty((grow,) + shape)])
-            out_p = np.concatenate([out_p, np.empty((grow, n_rings))])
+            rec = _grown(rec, counters)
         if bar is not None:
             bar.update(clock[0] - bar.n)
+        if status == STATUS_IMPULSE_AT_DT_MIN:
+            failure = (
+                f"the contact impulse per step stayed above Scene.impulse_tol = {scene.impulse_tol:g} N s "
+                f"at the smallest step Scene.dt_min = {scene.dt_min:g} s (t = {clock[0]:.6g} s); raise "
+                "impulse_tol or lower dt_min."
+            )
+            break
         if status == STATUS_STEP_TOO_SMALL:
             failure = (
                 f"step size fell below Scene.dt_min = {scene.dt_min:g} s at t = {clock[0]:.6g} s "
@@ -216,19 +220,46 @@ def simulate(scene, t_end, x0=None, v0=None, output_dt=None, progress=False):
         effects=scene.effects,
         integrator=scene.integrator,
     )
+    n_out = int(counters[COUNT_RECORDS])
+    n_ev = int(counters[COUNT_EVENTS])
     traj = Trajectory(
-        t=out_t[:n_out].copy(),
-        x=out_x[:n_out].copy(),
-        v=out_v[:n_out].copy(),
-        pressure=out_p[:n_out].copy(),
-        contact_force=np.zeros((n_out,) + shape),
-        events=[],
+        t=rec.t[:n_out].copy(),
+        x=rec.x[:n_out].copy(),
+        v=rec.v[:n_out].copy(),
+        pressure=rec.pressure[:n_out].copy(),
+        contact_force=rec.contact_force[:n_out].copy(),
+        events=event_list(rec.events[:n_ev]),
         stats=stats,
         scene=scene,
+        event_table=rec.events[:n_ev].copy(),
     )
     if failure is not None:
         raise SimulationError(failure, traj)
     return traj
+
+
+def _grown(rec, counters):
+    """A recording with room for more records and events, holding what ``rec`` has."""
+    n_out = int(counters[COUNT_RECORDS])
+    n_ev = int(counters[COUNT_EVENTS])
+    out_cap = rec.t.shape[0] * (2 if n_out >= rec.t.shape[0] else 1)
+    ev_cap = rec.events.shape[0] * 2
+    grown = empty_recording(out_cap, rec.x.shape[1], rec.x.shape[2], ev_cap)
+    for old, new in zip(rec[:-1], grown[:-1], strict=True):
+        new[:n_out] = old[:n_out]
+    grown.events[:n_ev] = rec.events[:n_ev]
+    return grown
+
+
+def _check_above_grounds(grounds, x):
+    for g, (nx, ny, d, _) in enumerate(grounds):
+        phi = x[..., 0] * nx + x[..., 1] * ny - d
+        if np.any(phi < 0.0):
+            ring, node = np.argwhere(phi < 0.0)[0]
+            raise ValueError(
+                f"simulate: node {node} of ring {ring} starts {-phi[ring, node]:.3g} m below "
+                f"Scene.grounds[{g}]: every node must start on or above every ground"
+            )
 
 
 def _progress_bar(t_end):

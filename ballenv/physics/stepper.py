@@ -21,34 +21,44 @@ error ``dx`` in ``x1`` is an error ``dx / h`` in velocity, which grows without b
 
 import math
 
-import numpy as np
 from numba import njit
 
-from .elastic import bend_force, bend_jacobian, stretch_force, stretch_jacobian
+from .contact import FREE, constrain_jacobian, constrain_residual, deepest_ground
+from .elastic import bend_energy, bend_force, bend_jacobian, stretch_energy, stretch_force, stretch_jacobian
+from .events import detect_events
 from .linalg import solve_band_low_rank
 from .loads import (
     DAMPING_NONE,
     damping_force,
     damping_jacobian,
+    gas_energy,
     gas_pressure,
     gas_pressure_slope,
+    gravity_energy,
     gravity_force,
     polygon_area,
     pressure_force,
     pressure_jacobian,
 )
-from .model import METHOD_BACKWARD_EULER
+from .model import CONTACT_MASS_MODIFICATION, CONTACT_NONE, METHOD_BACKWARD_EULER
 
 STATUS_DONE = 0
 STATUS_BUFFER_FULL = 1
 STATUS_STEP_TOO_SMALL = 2
+STATUS_IMPULSE_AT_DT_MIN = 3
 
 # counters: accepted steps, rejected steps, Newton iterations (linear solves), fixed-grid index
 COUNT_STEPS = 0
 COUNT_REJECTED = 1
 COUNT_NEWTON = 2
 COUNT_GRID = 3
-N_COUNTERS = 4
+COUNT_RECORDS = 4
+COUNT_EVENTS = 5
+N_COUNTERS = 6
+
+PENETRATION_TOLERANCE = -1e-12  # m: a free node deeper than this below a ground gets constrained
+MAX_CONTACT_SET_CHANGES = 64
+ENERGY_GROWTH_TOL = 1e-2  # largest energy gain of a step, relative to the ring's kinetic + elastic energy
 
 # clock: time (s), current step size (s)
 CLOCK_T = 0
@@ -77,6 +87,52 @@ def ring_force(model, r, x, v, f):
         gravity_force(model.node_mass[r], model.gravity, f)
     if model.damping_mode != DAMPING_NONE:
         damping_force(x, v, model.node_mass[r], model.damping, model.damping_mode, f)
+
+
+ENERGY_KINETIC = 0
+ENERGY_STRETCHING = 1
+ENERGY_BENDING = 2
+ENERGY_GAS = 3
+ENERGY_GRAVITY = 4
+ENERGY_PARTS = ("kinetic", "stretching", "bending", "gas", "gravity")
+
+
+@njit(cache=True)
+def ring_energy(model, r, x, v, parts):
+    """Energy (J) of ring ``r`` by part into ``parts`` (5,): kinetic, stretching, bending, gas (the
+    gas-law potential), gravity; returns their sum."""
+    m = model.node_mass[r]
+    kinetic = 0.0
+    for i in range(x.shape[0]):
+        kinetic += v[i, 0] * v[i, 0] + v[i, 1] * v[i, 1]
+    parts[ENERGY_KINETIC] = 0.5 * m * kinetic
+    parts[ENERGY_STRETCHING] = stretch_energy(x, model.rest_len[r], model.ea[r])
+    parts[ENERGY_BENDING] = bend_energy(x, model.rest_len[r], model.ei[r], model.rest_turn[r])
+    parts[ENERGY_GAS] = 0.0
+    if model.pressurised[r]:
+        parts[ENERGY_GAS] = gas_energy(
+            polygon_area(x), model.gas_constant[r], model.gas_exponent, model.atmospheric_pressure,
+            model.width[r],
+        )  # fmt: skip
+    parts[ENERGY_GRAVITY] = gravity_energy(x, m, model.gravity) if model.use_gravity else 0.0
+    return parts.sum()
+
+
+@njit(cache=True)
+def _energy_grew(model, r, x0, v0, x1, v1, parts):
+    """True if the step ``(x0, v0) -> (x1, v1)`` of ring ``r`` raised its energy by more than
+    ``ENERGY_GROWTH_TOL`` times its free energy (kinetic plus elastic and gas energy above the inflated
+    circle at rest, ``Model.rest_energy``). Nothing in a scene without actuation adds energy: the gas
+    and gravity are potentials; damping, friction and the ground's constraints only remove it. Far
+    too large implicit steps of a nonlinear ring can converge to such spurious solutions; they are
+    rejected and retried smaller."""
+    e0 = ring_energy(model, r, x0, v0, parts)
+    free = e0 - parts[ENERGY_GRAVITY] - model.rest_energy[r]
+    e1 = ring_energy(model, r, x1, v1, parts)
+    free += e1 - parts[ENERGY_GRAVITY] - model.rest_energy[r]
+    if not math.isfinite(e1):
+        return True
+    return e1 - e0 > ENERGY_GROWTH_TOL * 0.5 * max(free, 0.0) + 1e-12 * abs(e0)
 
 
 @njit(cache=True)
@@ -147,10 +203,63 @@ def _kinematics(solver, x0, v0, a0, h, x1, v1, a1, ws):
 
 
 @njit(cache=True)
-def newton_ring(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws):
+def _predict(solver, v0, a0, h, dx):
+    for i in range(dx.shape[0]):
+        for d in range(2):
+            dx[i, d] = h * v0[i, d]
+            if solver.method != METHOD_BACKWARD_EULER:
+                dx[i, d] += 0.5 * h * h * a0[i, d]
+
+
+@njit(cache=True)
+def _activate_penetrating(grounds, active, x1, only_deeper_than):
+    """Constrain free nodes below a ground; returns True if any was added."""
+    changed = False
+    for i in range(active.shape[0]):
+        if active[i] == FREE:
+            g, phi = deepest_ground(grounds, x1[i, 0], x1[i, 1])
+            if phi < only_deeper_than:
+                active[i] = g
+                changed = True
+    return changed
+
+
+@njit(cache=True)
+def _rest_on_grounds(grounds, active, v1, a1):
+    """A constrained node ends the step at rest in the ground's normal direction (normal velocity
+    and algorithmic acceleration zeroed): it sits on the surface. Without this, backward Euler's
+    ``v1 = (x1 - x0) / h`` leaves a node that arrived from a gap a velocity into the ground, and the
+    Newmark update of generalized-alpha reflects it and leaves an acceleration spike that the alpha_m
+    term feeds back into the next steps (the known weakness of Newmark schemes with contact)."""
+    for i in range(active.shape[0]):
+        g = active[i]
+        if g == FREE:
+            continue
+        nx, ny = grounds[g, 0], grounds[g, 1]
+        vn = v1[i, 0] * nx + v1[i, 1] * ny
+        an = a1[i, 0] * nx + a1[i, 1] * ny
+        v1[i, 0] -= vn * nx
+        v1[i, 1] -= vn * ny
+        a1[i, 0] -= an * nx
+        a1[i, 1] -= an * ny
+
+
+@njit(cache=True)
+def newton_ring(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active):
     """Solve one implicit step of ring ``r``; ``x1, v1, a1`` receive the new state.
 
-    Returns the number of Newton corrections (>= 0), or -1 if the step must be rejected.
+    ``active`` (N,) holds each node's constraining ground (or FREE) and is updated to the step's
+    contact set. Once the iteration has converged, constraints whose reaction pulls are released and
+    free nodes below a ground are constrained; then
+
+    * mass-modification (Baraff & Witkin) also constrains the nodes whose predicted position is below
+      a ground before the first iteration, and after a change goes on iterating from where it is
+      (the system keeps its size; one solve usually absorbs the change);
+    * predictor-corrector (the paper's method) recomputes the whole step from the predictor.
+
+    The set is never changed from an unconverged iterate: far from the solution an iterate may swing
+    nodes through a ground they never reach. ``ws.reaction``/``ws.friction`` receive the ground
+    reactions. Returns the number of Newton corrections (>= 0), or -1 if the step must be rejected.
     """
     n = x0.shape[0]
     m = model.node_mass[r]
@@ -164,15 +273,21 @@ def newton_ring(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws):
         c_x = 1.0 - solver.alpha_f
         c_v = (1.0 - solver.alpha_f) * solver.gamma / (solver.beta * h)
         am = solver.alpha_m
+    contact = model.contact_method != CONTACT_NONE
+    inner_updates = model.contact_method == CONTACT_MASS_MODIFICATION
+    set_changes = 0
     dx = ws.dx
-    for i in range(n):
-        for d in range(2):
-            dx[i, d] = h * v0[i, d]
-            if solver.method != METHOD_BACKWARD_EULER:
-                dx[i, d] += 0.5 * h * h * a0[i, d]
+    _predict(solver, v0, a0, h, dx)
+    if contact and inner_updates:
+        _kinematics(solver, x0, v0, a0, h, x1, v1, a1, ws)
+        if _activate_penetrating(model.grounds, active, x1, PENETRATION_TOLERANCE):
+            set_changes += 1
     res = ws.res
     f = ws.force
-    for it in range(solver.newton_max_iter + 1):
+    total = 0
+    settled = False
+    it = 0
+    while True:
         _kinematics(solver, x0, v0, a0, h, x1, v1, a1, ws)
         ring_force(model, r, ws.xe, ws.ve, f)
         worst = 0.0
@@ -184,15 +299,47 @@ def newton_ring(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws):
                 res[2 * i + d] = val
                 if not math.isfinite(val):
                     return -1
-                worst = max(worst, abs(val))
                 scale = max(scale, abs(inertia) + abs(f[i, d]))
-        if worst <= solver.newton_tol * scale:
-            return it
-        if it == solver.newton_max_iter:
+        if contact:
+            constrain_residual(
+                model.grounds, active, x1, ws.ve, res, m, c_mass, model.friction_regularization,
+                ws.reaction, ws.friction,
+            )  # fmt: skip
+        for k in range(2 * n):
+            worst = max(worst, abs(res[k]))
+        if settled or worst <= solver.newton_tol * scale:
+            if not contact:
+                return total
+            changed = False
+            for i in range(n):
+                if active[i] != FREE and ws.reaction[i] < 0.0:
+                    active[i] = FREE
+                    changed = True
+            if _activate_penetrating(model.grounds, active, x1, PENETRATION_TOLERANCE):
+                changed = True
+            if not changed:
+                _rest_on_grounds(model.grounds, active, v1, a1)
+                return total
+            set_changes += 1
+            if set_changes > MAX_CONTACT_SET_CHANGES:
+                return -1
+            settled = False
+            it = 0
+            if not inner_updates:
+                _predict(solver, v0, a0, h, dx)
+            continue  # the residual's rows changed with the set
+        if it >= solver.newton_max_iter:
             return -1
         rank = ring_jacobian(model, r, ws.xe, ws.ve, c_mass, c_x, c_v, ws)
+        if contact:
+            constrain_jacobian(
+                model.grounds, active, ws.ve, ws.reaction, ws.band, ws.pos, ws.u, rank, m, c_mass,
+                c_v, model.friction_regularization,
+            )  # fmt: skip
         if not solve_band_low_rank(ws.band, ws.pos, ws.u, ws.w, rank, res, ws.work, ws.cap, ws.coef):
             return -1
+        total += 1
+        it += 1
         step = 0.0
         size = 0.0
         for i in range(n):
@@ -203,10 +350,7 @@ def newton_ring(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws):
                 dx[i, d] -= delta
                 step = max(step, abs(delta))
                 size = max(size, abs(x0[i, d]) + abs(dx[i, d]))
-        if step <= 1e-13 * size:
-            _kinematics(solver, x0, v0, a0, h, x1, v1, a1, ws)
-            return it + 1
-    return -1
+        settled = step <= 1e-13 * size
 
 
 @njit(cache=True)
@@ -220,60 +364,104 @@ def initial_acceleration(model, x, v, a, ws):
 
 
 @njit(cache=True)
-def try_step(model, solver, x, v, a, h, x1, v1, a1, ws):
-    """One step of every ring; returns total Newton corrections, or -1 if any ring fails."""
-    total = 0
-    for r in range(x.shape[0]):
-        its = newton_ring(model, solver, r, x[r], v[r], a[r], h, x1[r], v1[r], a1[r], ws)
-        if its < 0:
-            return -1
-        total += its
-    return total
+def try_step(model, solver, state, trial, h, ws):
+    """One step of every ring from ``state`` into ``trial``.
 
-
-@njit(cache=True)
-def _record(model, k, t, x, v, out_t, out_x, out_v, out_p):
-    out_t[k] = t
-    out_x[k] = x
-    out_v[k] = v
-    for r in range(x.shape[0]):
-        out_p[k, r] = ring_pressure(model, r, x[r])
-
-
-@njit(cache=True)
-def advance(
-    model,
-    solver,
-    ws,
-    x,
-    v,
-    a,
-    x1,
-    v1,
-    a1,
-    clock,
-    counters,
-    t_pause,
-    t_end,
-    output_dt,
-    out_t,
-    out_x,
-    out_v,
-    out_p,
-    n_out,
-):
-    """Step the state ``x, v, a`` (R, N, 2) from ``clock[CLOCK_T]`` to ``t_end``, pausing (returning)
-    after the first step that reaches ``t_pause`` (<= ``t_end``; for progress reports).
-
-    Records the state into the ``out_*`` buffers from index ``n_out`` on: every accepted step if
-    ``output_dt == 0``, else exactly at multiples of ``output_dt`` (steps are shortened to land on
-    them). Returns ``(status, n_out)``; status is STATUS_DONE, STATUS_BUFFER_FULL (call again with
-    room) or STATUS_STEP_TOO_SMALL (the step fell below ``dt_min``: the state is the last accepted).
+    Returns (Newton corrections, contact impulse in N s), or (-1, 0) if any ring fails (the step is
+    then rejected). The contact impulse is the largest over rings of
+    ``|h sum_i f_i + kappa sum_(i arriving) m min(0, v_n,i + gap_i / h) n|``: the ring's total ground
+    reaction impulse over the step (its momentum change by contact, the paper's ``f dt``) less the
+    reaction that stops the nodes arriving on a ground in this step (normal velocity ``v_n < 0`` and
+    distance ``gap`` at the step's start). An arriving node loses its normal momentum in whatever
+    step it arrives (a point mass hitting a rigid wall), so no step size could bring that part under
+    a tolerance; the remainder grows with ``h`` and is what the step-size control bounds. ``kappa`` is
+    the integrator's reaction to an arrival per unit momentum: 1 for backward Euler,
+    ``(1 - alpha_m) / beta`` for generalized-alpha (whose Newmark update reflects the node's normal
+    velocity before :func:`_rest_on_grounds` removes it).
     """
-    capacity = out_t.shape[0]
+    total = 0
+    impulse = 0.0
+    contact = model.contact_method != CONTACT_NONE
+    for r in range(state.x.shape[0]):
+        trial.active[r] = state.active[r]
+        its = newton_ring(
+            model, solver, r, state.x[r], state.v[r], state.a[r], h, trial.x[r], trial.v[r],
+            trial.a[r], ws, trial.active[r],
+        )  # fmt: skip
+        if its < 0 or _energy_grew(model, r, state.x[r], state.v[r], trial.x[r], trial.v[r], ws.energy):
+            return -1, 0.0
+        total += its
+        if contact:
+            m = model.node_mass[r]
+            if solver.method != METHOD_BACKWARD_EULER:
+                m *= (1.0 - solver.alpha_m) / solver.beta
+            jx = 0.0
+            jy = 0.0
+            for i in range(state.x.shape[1]):
+                g = trial.active[r, i]
+                if g == FREE:
+                    trial.contact_force[r, i, 0] = 0.0
+                    trial.contact_force[r, i, 1] = 0.0
+                    continue
+                nx, ny = model.grounds[g, 0], model.grounds[g, 1]
+                fn, ft = ws.reaction[i], ws.friction[i]
+                fx = fn * nx - ft * ny
+                fy = fn * ny + ft * nx
+                trial.contact_force[r, i, 0] = fx
+                trial.contact_force[r, i, 1] = fy
+                jx += h * fx
+                jy += h * fy
+                if state.active[r, i] == FREE:
+                    # the reaction that stops the node on the surface: kappa m (v_n + gap / h)
+                    gap = max(0.0, nx * state.x[r, i, 0] + ny * state.x[r, i, 1] - model.grounds[g, 2])
+                    vn = min(0.0, state.v[r, i, 0] * nx + state.v[r, i, 1] * ny + gap / h)
+                    jx += m * vn * nx
+                    jy += m * vn * ny
+            impulse = max(impulse, math.sqrt(jx * jx + jy * jy))
+    return total, impulse
+
+
+@njit(cache=True)
+def _record(model, k, t, state, rec):
+    rec.t[k] = t
+    rec.x[k] = state.x
+    rec.v[k] = state.v
+    rec.contact_force[k] = state.contact_force
+    for r in range(state.x.shape[0]):
+        rec.pressure[k, r] = ring_pressure(model, r, state.x[r])
+
+
+@njit(cache=True)
+def _accept(state, trial):
+    state.x[:] = trial.x
+    state.v[:] = trial.v
+    state.a[:] = trial.a
+    state.active[:] = trial.active
+    state.contact_force[:] = trial.contact_force
+
+
+@njit(cache=True)
+def advance(model, solver, ws, state, trial, clock, counters, t_pause, t_end, output_dt, rec):
+    """Step ``state`` from ``clock[CLOCK_T]`` to ``t_end``, pausing (returning) after the first step
+    that reaches ``t_pause`` (<= ``t_end``; for progress reports).
+
+    Records into ``rec`` from index ``counters[COUNT_RECORDS]`` on: every accepted step if
+    ``output_dt == 0``, else exactly at multiples of ``output_dt`` (steps are shortened to land on
+    them); events go to ``rec.events`` rows (t, ring, kind, centre-of-mass height). Returns
+    STATUS_DONE, STATUS_BUFFER_FULL (call again with room), STATUS_STEP_TOO_SMALL (Newton failures
+    halved the step below ``dt_min``) or STATUS_IMPULSE_AT_DT_MIN (the contact impulse exceeds
+    ``impulse_tol`` even at ``dt_min``); on failure the state is the last accepted one.
+
+    Step control: a step whose Newton iteration fails is retried with half the step. Adaptive: with
+    ground contact, a step whose contact impulse (see :func:`try_step`) exceeds ``impulse_tol`` is
+    retried with ``h * max(0.2, 0.9 tol / (f h))``; accepted steps grow by ``min(growth, 1 + (ratio -
+    1) / 2)`` (cautious), up to ``dt``.
+    """
+    capacity = rec.t.shape[0]
+    n_rings = state.x.shape[0]
     while clock[CLOCK_T] < t_pause:
-        if n_out >= capacity:
-            return STATUS_BUFFER_FULL, n_out
+        if counters[COUNT_RECORDS] >= capacity or counters[COUNT_EVENTS] + 3 * n_rings > rec.events.shape[0]:
+            return STATUS_BUFFER_FULL
         t = clock[CLOCK_T]
         eps = 1e-9 * solver.dt
         stop = t + clock[CLOCK_H]
@@ -291,30 +479,32 @@ def advance(
         if at_end:
             stop = t_end
         h = stop - t
-        its = try_step(model, solver, x, v, a, h, x1, v1, a1, ws)
+        its, impulse = try_step(model, solver, state, trial, h, ws)
         if its < 0:
             counters[COUNT_REJECTED] += 1
             clock[CLOCK_H] = 0.5 * h
             if clock[CLOCK_H] < solver.dt_min:
-                return STATUS_STEP_TOO_SMALL, n_out
+                return STATUS_STEP_TOO_SMALL
+            continue
+        counters[COUNT_NEWTON] += its
+        ratio = math.inf if impulse == 0.0 else model.impulse_tol / impulse
+        if solver.adaptive and ratio < 1.0:
+            if h <= 1.001 * solver.dt_min:  # (h = stop - t carries round-off)
+                return STATUS_IMPULSE_AT_DT_MIN
+            counters[COUNT_REJECTED] += 1
+            clock[CLOCK_H] = max(solver.dt_min, h * max(0.2, 0.9 * ratio))
             continue
         counters[COUNT_STEPS] += 1
-        counters[COUNT_NEWTON] += its
-        x[:] = x1
-        v[:] = v1
-        a[:] = a1
+        counters[COUNT_EVENTS] = detect_events(model, state, trial, t, h, rec.events, counters[COUNT_EVENTS])
+        _accept(state, trial)
         clock[CLOCK_T] = stop
         if solver.adaptive:
-            clock[CLOCK_H] = min(clock[CLOCK_H] * solver.growth, solver.dt)
+            growth = min(solver.growth, max(1.0, 1.0 + 0.5 * (ratio - 1.0)))
+            clock[CLOCK_H] = min(max(h, clock[CLOCK_H]) * growth, solver.dt)
         elif at_grid:
             counters[COUNT_GRID] += 1
             clock[CLOCK_H] = solver.dt
         if output_dt == 0.0 or at_out or at_end:
-            _record(model, n_out, stop, x, v, out_t, out_x, out_v, out_p)
-            n_out += 1
-    return STATUS_DONE, n_out
-
-
-def empty_state(n_rings, n_nodes):
-    """Zeroed (R, N, 2) arrays for a state and a trial state."""
-    return [np.zeros((n_rings, n_nodes, 2)) for _ in range(6)]
+            _record(model, counters[COUNT_RECORDS], stop, state, rec)
+            counters[COUNT_RECORDS] += 1
+    return STATUS_DONE

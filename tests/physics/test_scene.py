@@ -22,6 +22,7 @@ from ballenv.physics import Ring, Scene, simulate
         ({"width": 0.0}, "width"),
         ({"pressure": -1.0}, "pressure"),
         ({"pressure": math.nan}, "pressure"),
+        ({"pressure": 1.1e5}, "pressure"),  # E h / (2 R) = 1e5 Pa would stretch the wall by 100 %
         ({"position": (0.0, math.nan)}, "position"),
         ({"position": (0.0, 1.0, 2.0)}, "position"),
         ({"velocity": "fast"}, "velocity"),

@@ -8,6 +8,7 @@ import pytest
 
 from ballenv.physics import Ring, Scene, SimulationError, energy, simulate
 from ballenv.physics.loads import polygon_area
+from ballenv.physics.ring import inflated_radius
 
 E, RHO, R = 10e6, 1100.0, 0.1
 BREATHING_OMEGA = math.sqrt(E / RHO) / R  # rad/s
@@ -71,7 +72,13 @@ def test_breathing_mode_convergence_order(integrator, order):
     assert errors[0] / errors[1] == pytest.approx(2.0**order, rel=0.1)
 
 
+def _circle(radius, n_nodes=64):
+    theta = 2 * np.pi * np.arange(n_nodes) / n_nodes
+    return radius * np.stack([np.cos(theta), np.sin(theta)], axis=1)
+
+
 def _pressurised_equilibrium(pressure, n_nodes=64):
+    """Release the ring unstretched (radius R) and let damping settle it on its inflated circle."""
     scene = Scene(
         rings=[_ring(pressure=pressure, n_nodes=n_nodes, position=(0.0, 0.0))],
         gravity=0.0,
@@ -79,11 +86,12 @@ def _pressurised_equilibrium(pressure, n_nodes=64):
         integrator="backward_euler",
         dt=1e-3,
     )
-    return scene, simulate(scene, 1.0, output_dt=0.1)
+    return scene, simulate(scene, 1.0, x0=_circle(R, n_nodes), output_dt=0.1)
 
 
-def test_pressurised_ring_hoop_strain_is_p_b_R_over_EA():
-    scene, traj = _pressurised_equilibrium(1e3)
+@pytest.mark.parametrize("pressure", [1e3, 30e3])
+def test_pressurised_ring_settles_where_hoop_tension_p_b_r_balances_the_gas(pressure):
+    scene, traj = _pressurised_equilibrium(pressure)
     ring = scene.rings[0]
     x = traj.x[-1, 0]
     radius = np.linalg.norm(x - x.mean(axis=0), axis=1).mean()
@@ -92,7 +100,19 @@ def test_pressurised_ring_hoop_strain_is_p_b_R_over_EA():
     p = traj.pressure[-1, 0]
     ea = ring.youngs_modulus * ring.width * ring.thickness
     assert np.max(np.abs(traj.v[-1])) < 1e-6  # at rest
-    assert strain == pytest.approx(p * ring.width * radius / ea, rel=1e-2)
+    # thin-ring hoop tension T = p b r (cos(pi/N): the polygon's edges meet at an angle)
+    assert strain * ea == pytest.approx(p * ring.width * radius * math.cos(math.pi / 64), rel=1e-6)
+    # the inflated start is that same equilibrium, and Ring.pressure is its gauge pressure
+    assert p == pytest.approx(pressure, rel=1e-6)
+    assert radius == pytest.approx(inflated_radius(ring), rel=1e-7)
+
+
+def test_a_pressurised_ring_starts_inflated_and_at_rest():
+    ring = _ring(pressure=30e3, position=(0.0, 0.0))
+    traj = simulate(Scene(rings=[ring], gravity=0.0, dt=1e-4), 0.01)
+    assert inflated_radius(ring) > 1.05 * R  # 30 kPa stretches this wall by about 7 %
+    assert np.max(np.abs(traj.v)) < 1e-8
+    np.testing.assert_allclose(traj.pressure[:, 0], 30e3, rtol=1e-9)
 
 
 def test_gas_law_holds_along_a_trajectory():
@@ -105,8 +125,8 @@ def test_gas_law_holds_along_a_trajectory():
     p_atm = scene.atmospheric_pressure
     area = np.array([polygon_area(x) for x in traj.x[:, 0]])
     invariant = (traj.pressure[:, 0] + p_atm) * area
-    a0 = 64 * R**2 * math.sin(2 * math.pi / 64) / 2
-    assert np.max(np.abs(invariant / ((30e3 + p_atm) * a0) - 1)) < 1e-9
+    a_inflated = 64 * inflated_radius(ring) ** 2 * math.sin(2 * math.pi / 64) / 2
+    assert np.max(np.abs(invariant / ((30e3 + p_atm) * a_inflated) - 1)) < 1e-9
     assert np.ptp(area) / area.mean() > 0.01  # the gas really was squashed and expanded
 
 

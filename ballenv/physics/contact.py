@@ -1,0 +1,119 @@
+"""Ground half-planes: constrained nodes, reactions and Coulomb friction inside the Newton system.
+
+A ground ``g`` is the half-plane ``n_g . x >= d_g`` with unit normal ``n_g = (-sin a, cos a)`` for a
+slope angle ``a`` (rad) and ``d_g = height cos a`` (the surface passes through ``(0, height)``).
+A node in contact is constrained on the surface and keeps the size of the system (Baraff & Witkin's
+filtered, mass-modified formulation written for the step's displacement): its two residual rows
+(``r_i = M inertia_i - F_i``, N) become
+
+    tangential:  t . r_i + mu N_i s(v_t)   = 0     (Coulomb friction, N_i = n . r_i the reaction)
+    normal:      c_M m (n . x1_i - d)     = 0     (the node ends the step on the surface)
+
+with ``t = (-n_y, n_x)``, ``v_t = t . v_i`` and the regularised sign ``s(v) = v / sqrt(v^2 + eps^2)``
+(``eps`` = ``Scene.friction_regularization``, m/s). The Jacobian rows are the same combinations of
+the unconstrained rows (exact, including ``dN_i/dx = n . J_i`` and ``mu N s'(v_t) dv_t/dx``), so the
+band structure and the low-rank Woodbury terms survive. A constraint whose reaction ``N_i`` pulls is
+released; a free node below a ground is constrained.
+"""
+
+import math
+
+from numba import njit
+
+from .linalg import BAND_HALF_WIDTH
+
+FREE = -1
+
+
+@njit(cache=True)
+def deepest_ground(grounds, x, y):
+    """(ground index, signed distance in m) of the ground the point is deepest below (or nearest)."""
+    best = 0
+    best_phi = math.inf
+    for g in range(grounds.shape[0]):
+        phi = grounds[g, 0] * x + grounds[g, 1] * y - grounds[g, 2]
+        if phi < best_phi:
+            best_phi = phi
+            best = g
+    return best, best_phi
+
+
+@njit(cache=True)
+def constrain_residual(grounds, active, x1, ve, res, node_mass, c_mass, eps, reaction, friction):
+    """Replace the rows of active nodes (see module doc); store their normal reaction N_i (N) in
+    ``reaction`` and the friction force along t (N) in ``friction``. Returns the largest ``|r|`` scale
+    contribution of the constraint rows."""
+    n = active.shape[0]
+    for i in range(n):
+        g = active[i]
+        if g == FREE:
+            reaction[i] = 0.0
+            friction[i] = 0.0
+            continue
+        nx, ny, d, mu = grounds[g, 0], grounds[g, 1], grounds[g, 2], grounds[g, 3]
+        tx, ty = -ny, nx
+        rx, ry = res[2 * i], res[2 * i + 1]
+        rn = nx * rx + ny * ry
+        rt = tx * rx + ty * ry
+        s = 0.0
+        if mu > 0.0:
+            vt = tx * ve[i, 0] + ty * ve[i, 1]
+            s = vt / math.sqrt(vt * vt + eps * eps)
+        reaction[i] = rn
+        friction[i] = -mu * rn * s
+        row_t = rt + mu * rn * s
+        row_n = c_mass * node_mass * (nx * x1[i, 0] + ny * x1[i, 1] - d)
+        if abs(nx) > abs(ny):
+            res[2 * i], res[2 * i + 1] = row_n, row_t
+        else:
+            res[2 * i], res[2 * i + 1] = row_t, row_n
+
+
+@njit(cache=True)
+def constrain_jacobian(grounds, active, ve, reaction, band, pos, u, rank, node_mass, c_mass, c_v, eps):
+    """Apply the row combinations of :func:`constrain_residual` to the band and to the rows of the
+    low-rank factor ``u`` (natural order)."""
+    w = BAND_HALF_WIDTH
+    n = active.shape[0]
+    for i in range(n):
+        g = active[i]
+        if g == FREE:
+            continue
+        nx, ny, mu = grounds[g, 0], grounds[g, 1], grounds[g, 3]
+        tx, ty = -ny, nx
+        s = 0.0
+        ds = 0.0
+        if mu > 0.0:
+            vt = tx * ve[i, 0] + ty * ve[i, 1]
+            q = vt * vt + eps * eps
+            s = vt / math.sqrt(q)
+            ds = eps * eps / (q * math.sqrt(q))
+        ax = tx + mu * s * nx
+        ay = ty + mu * s * ny
+        p = 2 * pos[i]
+        swap = abs(nx) > abs(ny)
+        row_t = p + 1 if swap else p
+        row_n = p if swap else p + 1
+        # columns of node blocks within 4 positions: DOFs p - 8 .. p + 9
+        lo = max(0, p - 2 * 4)
+        hi = min(band.shape[0] - 1, p + 2 * 4 + 1)
+        new_t = 0.0
+        for c in range(lo, hi + 1):
+            vx = band[p, w + c - p]
+            vy = band[p + 1, w + c - p - 1]
+            new_t = ax * vx + ay * vy
+            band[row_t, w + c - row_t] = new_t
+            band[row_n, w + c - row_n] = 0.0
+        extra = mu * reaction[i] * ds * c_v
+        band[row_t, w + p - row_t] += extra * tx
+        band[row_t, w + p + 1 - row_t] += extra * ty
+        band[row_n, w + p - row_n] = c_mass * node_mass * nx
+        band[row_n, w + p + 1 - row_n] = c_mass * node_mass * ny
+        for k in range(rank):
+            ut = ax * u[2 * i, k] + ay * u[2 * i + 1, k]
+            if swap:
+                u[2 * i, k] = 0.0
+                u[2 * i + 1, k] = ut
+            else:
+                u[2 * i, k] = ut
+                u[2 * i + 1, k] = 0.0

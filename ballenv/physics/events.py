@@ -1,0 +1,95 @@
+"""Events located inside an accepted step: touchdown, lift-off and apex.
+
+Rows of the event buffer: ``(t (s), ring, kind, centre-of-mass height (m))`` with kind
+0 = touchdown, 1 = liftoff, 2 = apex.
+
+* apex: the vertical centre-of-mass velocity changes sign from up to down within the step; its time
+  by linear interpolation of that velocity, its height by the cubic Hermite interpolant of the
+  centre-of-mass height (values and velocities at both ends), so the bounce height is exact to the
+  integrator's order, not to the output sampling;
+* touchdown: the ring had no node on a ground and now has; time from the ballistic path of the first
+  node to touch (``phi0 + s h v_n = 0``);
+* lift-off: the last constraint was released; time = the end of the step (steps are short in contact).
+"""
+
+import numpy as np
+from numba import njit
+
+from .contact import FREE, deepest_ground
+
+EVENT_TOUCHDOWN = 0
+EVENT_LIFTOFF = 1
+EVENT_APEX = 2
+EVENT_KINDS = ("touchdown", "liftoff", "apex")
+
+
+@njit(cache=True)
+def _centre(x, v):
+    n = x.shape[0]
+    cy = 0.0
+    vy = 0.0
+    for i in range(n):
+        cy += x[i, 1]
+        vy += v[i, 1]
+    return cy / n, vy / n
+
+
+@njit(cache=True)
+def _hermite(y0, y1, d0, d1, s):
+    """Cubic Hermite on [0, 1] with end values y0, y1 and end slopes d0, d1 (per unit s)."""
+    s2 = s * s
+    s3 = s2 * s
+    return (2 * s3 - 3 * s2 + 1) * y0 + (s3 - 2 * s2 + s) * d0 + (-2 * s3 + 3 * s2) * y1 + (s3 - s2) * d1
+
+
+@njit(cache=True)
+def detect_events(model, state, trial, t, h, events, n_events):
+    """Append the events of the step ``state -> trial`` over ``[t, t + h]``; return the new count."""
+    n_rings = state.x.shape[0]
+    n_nodes = state.x.shape[1]
+    contact = model.grounds.shape[0] > 0
+    for r in range(n_rings):
+        y0, vy0 = _centre(state.x[r], state.v[r])
+        y1, vy1 = _centre(trial.x[r], trial.v[r])
+        if contact:
+            before = 0
+            after = 0
+            for i in range(n_nodes):
+                if state.active[r, i] != FREE:
+                    before += 1
+                if trial.active[r, i] != FREE:
+                    after += 1
+            if before == 0 and after > 0:
+                s_first = 1.0
+                for i in range(n_nodes):
+                    if trial.active[r, i] == FREE:
+                        continue
+                    g, phi0 = deepest_ground(model.grounds, state.x[r, i, 0], state.x[r, i, 1])
+                    vn = model.grounds[g, 0] * state.v[r, i, 0] + model.grounds[g, 1] * state.v[r, i, 1]
+                    if vn < 0.0:
+                        s_first = min(s_first, max(0.0, phi0 / (-vn * h)))
+                s_first = min(s_first, 1.0)
+                events[n_events, 0] = t + s_first * h
+                events[n_events, 1] = r
+                events[n_events, 2] = EVENT_TOUCHDOWN
+                events[n_events, 3] = _hermite(y0, y1, vy0 * h, vy1 * h, s_first)
+                n_events += 1
+            elif before > 0 and after == 0:
+                events[n_events, 0] = t + h
+                events[n_events, 1] = r
+                events[n_events, 2] = EVENT_LIFTOFF
+                events[n_events, 3] = y1
+                n_events += 1
+        if vy0 > 0.0 and vy1 <= 0.0:
+            s = vy0 / (vy0 - vy1)
+            events[n_events, 0] = t + s * h
+            events[n_events, 1] = r
+            events[n_events, 2] = EVENT_APEX
+            events[n_events, 3] = _hermite(y0, y1, vy0 * h, vy1 * h, s)
+            n_events += 1
+    return n_events
+
+
+def event_list(rows):
+    """Event rows -> list of (t, ring, kind) tuples."""
+    return [(float(t), int(r), EVENT_KINDS[int(k)]) for t, r, k, _ in np.asarray(rows)]

@@ -1,0 +1,57 @@
+"""Step control: the impulse-driven adaptive step against fixed steps, and the energy guard."""
+
+import numpy as np
+import pytest
+
+from ballenv.physics import Ground, Ring, Scene, simulate
+from ballenv.physics.model import build_model
+from ballenv.physics.simulate import initial_state
+from ballenv.physics.stepper import _energy_grew
+
+
+def _first_apex(**scene_kw):
+    scene = Scene(rings=[Ring(position=(0.0, 0.6))], grounds=[Ground()], **scene_kw)
+    traj = simulate(scene, 0.9)
+    return traj.apexes()[0, 1], traj.stats.steps + traj.stats.rejected_steps, traj
+
+
+def test_adaptive_step_reaches_first_apex_accuracy_in_fewer_steps_than_fixed_steps():
+    reference, _, _ = _first_apex(adaptive=True, dt=1e-3, impulse_tol=1e-4)
+    apex, steps, _ = _first_apex(adaptive=True, dt=1e-3, impulse_tol=1e-3)
+    error = abs(apex - reference) / reference
+    assert error < 5e-3
+    for dt in (1e-3, 5e-4, 2.5e-4):  # fixed steps up to 2.8x the adaptive run's steps all miss it
+        fixed, fixed_steps, _ = _first_apex(adaptive=False, dt=dt)
+        assert abs(fixed - reference) / reference > error
+    assert fixed_steps > 2.5 * steps
+
+
+def test_adaptive_steps_are_large_in_flight_and_small_in_contact():
+    _, _, traj = _first_apex(adaptive=True, dt=1e-3, impulse_tol=1e-3)
+    h = np.diff(traj.t)
+    in_contact = np.any(traj.contact_force[1:, 0, :, 1] > 0, axis=1)
+    assert np.median(h[~in_contact]) == pytest.approx(1e-3)
+    assert np.median(h[in_contact]) < 2.5e-4
+
+
+@pytest.mark.parametrize("integrator", ["generalized_alpha", "backward_euler"])
+@pytest.mark.parametrize("adaptive", [True, False])
+def test_a_forced_large_step_bounce_stays_stable_and_never_gains_energy(integrator, adaptive):
+    _, _, traj = _first_apex(integrator=integrator, adaptive=adaptive, dt=1e-2)
+    energy = traj.energy()["total"][:, 0]
+    assert np.all(np.isfinite(traj.x))
+    assert np.min(traj.x[..., 1]) >= -1e-6
+    assert np.max(energy - energy[0]) <= 1e-12 * abs(energy[0])
+    assert len(traj.apexes()) >= 1
+
+
+def test_energy_guard_flags_a_step_that_adds_energy():
+    scene = Scene(rings=[Ring(position=(0.0, 0.0))], gravity=0.0)
+    model = build_model(scene)
+    x, v = initial_state(scene)
+    parts = np.zeros(5)
+    moving = v[0] + np.array([0.0, 0.05])  # kinetic energy from nowhere
+    assert not _energy_grew(model, 0, x[0], v[0], x[0], v[0], parts)
+    assert _energy_grew(model, 0, x[0], v[0], x[0], moving, parts)
+    assert not _energy_grew(model, 0, x[0], moving, x[0], v[0], parts)
+    assert _energy_grew(model, 0, x[0], v[0], x[0], np.full_like(moving, np.nan), parts)
