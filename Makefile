@@ -27,6 +27,8 @@ test-slow: $(STAMP)
 
 bench: $(STAMP)
 	$(PY) benchmarks/step_cost.py
+	$(PY) benchmarks/linear_solve.py
+	$(PY) benchmarks/contact_cost.py
 
 lint: $(STAMP)
 	$(PY) -m ruff check .

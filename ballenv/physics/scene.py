@@ -178,10 +178,14 @@ class Scene:
         contact: "mass_modification" (Baraff-Witkin: the contact set is updated inside the Newton
             iteration; the system keeps its size) or "predictor_corrector" (the paper's first
             method: the whole step is recomputed after each change of the contact set).
-        impulse_tol: largest node reaction impulse per step ``f dt`` (N s) in (0, 10] when
-            ``adaptive``; larger steps are rejected and shrunk by the ratio.
-        friction_regularization: slip speed (m/s) in (0, 1] below which Coulomb friction is
-            smoothed, ``mu N v / sqrt(v^2 + eps^2)``.
+        impulse_tol: largest contact impulse per step ``f dt`` (N s) in (0, 10] when ``adaptive``: a
+            ring's total ground reaction over the step, net of the momentum of nodes arriving on the
+            ground in it (see ``stepper.try_step``); larger steps are rejected and shrunk by the
+            ratio, smaller ones grow by at most x1.25.
+        friction_regularization: slip speed eps (m/s) in (0, 1] below which Coulomb friction is
+            smoothed, ``mu N v / sqrt(v^2 + eps^2)``. A sticking node creeps at about eps times its
+            tangential load over mu N (a ball rolling down a 0.2 rad slope: 0.5 mm/s at the default
+            1e-2). Much smaller values (<= 1e-3) make Newton's iteration stall in sticking contact.
         gravity: magnitude g (m/s^2) along -y, in [0, 1000]; or a vector (gx, gy). 0 turns it off.
         damping: c (1/s) in [0, 1e6] of the deformation damping ``F_i = -c m (u_i - u_rigid,i)``.
         damping_mode: "rigid" (relative to the rigid motion: flight and spin undamped) or
@@ -204,7 +208,7 @@ class Scene:
     grounds: tuple = ()
     contact: str = "mass_modification"
     impulse_tol: float = 5e-3
-    friction_regularization: float = 1e-4
+    friction_regularization: float = 1e-2
     gravity: float | tuple = 9.81
     damping: float = 0.0
     damping_mode: str = "rigid"

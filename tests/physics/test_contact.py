@@ -105,6 +105,33 @@ def test_a_slope_equals_flat_ground_with_gravity_rotated(contact):
     assert np.max(np.abs(rotated_back - traj_s.x)) < 1e-8
 
 
+@pytest.mark.parametrize("contact", METHODS)
+def test_on_a_slope_a_ring_slides_at_g_sin_a_without_friction_and_rolls_at_half_with_it(contact):
+    angle = 0.2
+    ring = Ring(pressure=60e3, position=(0.0, 0.0))
+    radius = inflated_radius(ring)
+    theta = 2 * np.pi * np.arange(ring.n_nodes) / ring.n_nodes
+    normal = np.array([-math.sin(angle), math.cos(angle)])
+    downhill = -np.array([math.cos(angle), math.sin(angle)])
+    x0 = radius * np.stack([np.cos(theta), np.sin(theta)], axis=1) + (radius + 1e-9) * normal
+    expected = {0.0: G * math.sin(angle), 1.0: G * math.sin(angle) / 2}  # slide; roll (a hoop)
+    for mu, acceleration in expected.items():
+        scene = Scene(
+            rings=[ring], grounds=[Ground(angle=angle, friction=mu)], contact=contact, damping=50.0,
+            dt=1e-3, adaptive=True, impulse_tol=1e-3,
+        )  # fmt: skip
+        traj = simulate(scene, 0.5, x0=x0, output_dt=0.01)
+        s = traj.centre_of_mass()[:, 0] @ downhill
+        fitted = 2 * np.polyfit(traj.t[10:], s[10:], 2)[0]
+        touching = np.any(traj.contact_force[-1, 0] != 0, axis=1)
+        slip = traj.v[-1, 0, touching] @ downhill
+        if mu == 0.0:
+            assert fitted == pytest.approx(acceleration, rel=1e-6)
+        else:  # rolling without slipping; the squashed contact patch costs a little
+            assert fitted == pytest.approx(acceleration, rel=3e-2)
+            assert np.max(np.abs(slip)) < 2e-3  # m/s: sticking nodes barely creep
+
+
 def _spin(x, v):
     """Angular velocity (rad/s, counter-clockwise) of equal-mass nodes about their centre."""
     r = x - x.mean(axis=0)
