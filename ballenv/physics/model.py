@@ -11,9 +11,9 @@ from typing import NamedTuple
 import numpy as np
 
 from . import ring as ring_geometry
-from .elastic import stretch_energy
+from .energy import ENERGY_GRAVITY, ENERGY_PARTS, ring_energy
 from .linalg import BAND_COLUMNS, MAX_LOW_RANK, zigzag_positions
-from .loads import DAMPING_CENTRE_OF_MASS, DAMPING_NONE, DAMPING_RIGID, gas_energy
+from .loads import DAMPING_CENTRE_OF_MASS, DAMPING_NONE, DAMPING_RIGID
 
 METHOD_BACKWARD_EULER = 0
 METHOD_GENERALIZED_ALPHA = 1
@@ -84,6 +84,7 @@ class State(NamedTuple):
     a: np.ndarray  # (R, N, 2) m/s^2 (the generalized-alpha acceleration)
     active: np.ndarray  # (R, N) int64: constraining ground of each node, or -1
     contact_force: np.ndarray  # (R, N, 2) N
+    energy: np.ndarray  # (R, 2) J: each ring's energy and its free part (stepper.free_energy)
 
 
 class Recording(NamedTuple):
@@ -126,7 +127,7 @@ def build_model(scene):
     else:
         mode = DAMPING_CENTRE_OF_MASS
     gravity = np.array(scene.gravity_vector, dtype=float)
-    return Model(
+    model = Model(
         node_mass=np.array([ring_geometry.node_mass(r) for r in rings]),
         ea=np.array([ring_geometry.stretching_stiffness(r) for r in rings]),
         ei=np.array([ring_geometry.bending_stiffness(r) for r in rings]),
@@ -152,24 +153,19 @@ def build_model(scene):
         ),
         friction_regularization=float(scene.friction_regularization),
         impulse_tol=float(scene.impulse_tol),
-        rest_energy=np.array([_rest_energy(r, p_atm, k) for r in rings]),
+        rest_energy=np.zeros(len(rings)),
     )
+    _fill_rest_energy(model, rings)
+    return model
 
 
-def _rest_energy(ring, atmospheric_pressure, gas_exponent):
-    """Stretching plus gas energy (J) of ``ring`` on its inflated circle: the floor of its potential
-    energy without gravity (a regular polygon has no bending energy)."""
-    r = ring_geometry.inflated_radius(ring)
-    n = ring.n_nodes
-    theta = 2.0 * np.pi * np.arange(n) / n
-    x = r * np.stack([np.cos(theta), np.sin(theta)], axis=1)
-    rest_len = ring_geometry.rest_edge_length(ring.radius, n)
-    out = stretch_energy(x, rest_len, ring_geometry.stretching_stiffness(ring))
-    if ring.pressure is not None:
-        area = ring_geometry.rest_area(r, n)
-        gas_constant = (ring.pressure + atmospheric_pressure) * area**gas_exponent
-        out += gas_energy(area, gas_constant, gas_exponent, atmospheric_pressure, ring.width)
-    return out
+def _fill_rest_energy(model, rings):
+    """``model.rest_energy[r]``: energy (J) of ring ``r`` on its inflated circle at rest, gravity
+    left out: the floor of its potential energy (a regular polygon has no bending energy)."""
+    parts = np.zeros(len(ENERGY_PARTS))
+    for r, ring in enumerate(rings):
+        x, _ = ring_geometry.initial_nodes(ring)
+        model.rest_energy[r] = ring_energy(model, r, x, np.zeros_like(x), parts) - parts[ENERGY_GRAVITY]
 
 
 def ground_array(grounds):
@@ -236,6 +232,7 @@ def empty_state(n_rings, n_nodes):
         a=np.zeros(shape),
         active=np.full((n_rings, n_nodes), -1, dtype=np.int64),
         contact_force=np.zeros(shape),
+        energy=np.zeros((n_rings, 2)),
     )
 
 

@@ -6,9 +6,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import ring as ring_geometry
-from .events import event_list
+from .energy import ENERGY_PARTS, ring_energy
+from .events import EVENT_APEX, event_list
 from .model import (
-    METHOD_GENERALIZED_ALPHA,
     build_model,
     build_solver,
     build_workspace,
@@ -23,15 +23,13 @@ from .stepper import (
     COUNT_RECORDS,
     COUNT_REJECTED,
     COUNT_STEPS,
-    ENERGY_PARTS,
     N_COUNTERS,
     STATUS_BUFFER_FULL,
     STATUS_IMPULSE_AT_DT_MIN,
     STATUS_STEP_TOO_SMALL,
     _record,
     advance,
-    initial_acceleration,
-    ring_energy,
+    initial_state_values,
 )
 
 
@@ -89,7 +87,7 @@ class Trajectory:
         rows = self.event_table
         if rows is None or len(rows) == 0:
             return np.zeros((0, 2))
-        sel = (rows[:, 1] == ring) & (rows[:, 2] == 2)
+        sel = (rows[:, 1] == ring) & (rows[:, 2] == EVENT_APEX)
         return rows[sel][:, [0, 3]]
 
     def centre_of_mass(self):
@@ -169,8 +167,7 @@ def simulate(scene, t_end, x0=None, v0=None, output_dt=None, progress=False):
     state.x[:] = _check_state("x0", x0, shape) if x0 is not None else x_init
     state.v[:] = _check_state("v0", v0, shape) if v0 is not None else v_init
     _check_above_grounds(model.grounds, state.x)
-    if solver.method == METHOD_GENERALIZED_ALPHA:
-        initial_acceleration(model, state.x, state.v, state.a, ws)
+    initial_state_values(model, solver, state, ws)
     trial = empty_state(n_rings, n_nodes)
     clock = np.array([0.0, solver.dt])
     counters = np.zeros(N_COUNTERS, dtype=np.int64)

@@ -24,17 +24,16 @@ import math
 from numba import njit
 
 from .contact import FREE, constrain_jacobian, constrain_residual, deepest_ground
-from .elastic import bend_energy, bend_force, bend_jacobian, stretch_energy, stretch_force, stretch_jacobian
+from .elastic import bend_force, bend_jacobian, stretch_force, stretch_jacobian
+from .energy import ENERGY_GRAVITY, ring_energy
 from .events import detect_events
 from .linalg import solve_band_low_rank
 from .loads import (
     DAMPING_NONE,
     damping_force,
     damping_jacobian,
-    gas_energy,
     gas_pressure,
     gas_pressure_slope,
-    gravity_energy,
     gravity_force,
     polygon_area,
     pressure_force,
@@ -58,7 +57,7 @@ N_COUNTERS = 6
 
 PENETRATION_TOLERANCE = -1e-12  # m: a free node deeper than this below a ground gets constrained
 MAX_CONTACT_SET_CHANGES = 64
-ENERGY_GROWTH_TOL = 1e-2  # largest energy gain of a step, relative to the ring's kinetic + elastic energy
+ENERGY_GROWTH_TOL = 1e-2  # largest energy gain of a step, relative to the ring's free energy
 
 # clock: time (s), current step size (s)
 CLOCK_T = 0
@@ -89,50 +88,25 @@ def ring_force(model, r, x, v, f):
         damping_force(x, v, model.node_mass[r], model.damping, model.damping_mode, f)
 
 
-ENERGY_KINETIC = 0
-ENERGY_STRETCHING = 1
-ENERGY_BENDING = 2
-ENERGY_GAS = 3
-ENERGY_GRAVITY = 4
-ENERGY_PARTS = ("kinetic", "stretching", "bending", "gas", "gravity")
+@njit(cache=True)
+def free_energy(model, r, x, v, parts, out):
+    """``out[0]`` = the energy (J) of ring ``r``; ``out[1]`` = its free part: kinetic plus elastic and
+    gas energy above the inflated circle at rest (``Model.rest_energy``), gravity left out."""
+    out[0] = ring_energy(model, r, x, v, parts)
+    out[1] = out[0] - parts[ENERGY_GRAVITY] - model.rest_energy[r]
 
 
 @njit(cache=True)
-def ring_energy(model, r, x, v, parts):
-    """Energy (J) of ring ``r`` by part into ``parts`` (5,): kinetic, stretching, bending, gas (the
-    gas-law potential), gravity; returns their sum."""
-    m = model.node_mass[r]
-    kinetic = 0.0
-    for i in range(x.shape[0]):
-        kinetic += v[i, 0] * v[i, 0] + v[i, 1] * v[i, 1]
-    parts[ENERGY_KINETIC] = 0.5 * m * kinetic
-    parts[ENERGY_STRETCHING] = stretch_energy(x, model.rest_len[r], model.ea[r])
-    parts[ENERGY_BENDING] = bend_energy(x, model.rest_len[r], model.ei[r], model.rest_turn[r])
-    parts[ENERGY_GAS] = 0.0
-    if model.pressurised[r]:
-        parts[ENERGY_GAS] = gas_energy(
-            polygon_area(x), model.gas_constant[r], model.gas_exponent, model.atmospheric_pressure,
-            model.width[r],
-        )  # fmt: skip
-    parts[ENERGY_GRAVITY] = gravity_energy(x, m, model.gravity) if model.use_gravity else 0.0
-    return parts.sum()
-
-
-@njit(cache=True)
-def _energy_grew(model, r, x0, v0, x1, v1, parts):
-    """True if the step ``(x0, v0) -> (x1, v1)`` of ring ``r`` raised its energy by more than
-    ``ENERGY_GROWTH_TOL`` times its free energy (kinetic plus elastic and gas energy above the inflated
-    circle at rest, ``Model.rest_energy``). Nothing in a scene without actuation adds energy: the gas
-    and gravity are potentials; damping, friction and the ground's constraints only remove it. Far
-    too large implicit steps of a nonlinear ring can converge to such spurious solutions; they are
-    rejected and retried smaller."""
-    e0 = ring_energy(model, r, x0, v0, parts)
-    free = e0 - parts[ENERGY_GRAVITY] - model.rest_energy[r]
-    e1 = ring_energy(model, r, x1, v1, parts)
-    free += e1 - parts[ENERGY_GRAVITY] - model.rest_energy[r]
-    if not math.isfinite(e1):
+def _energy_grew(before, after):
+    """True if a step from energies ``before`` to ``after`` (each (total, free) in J, see
+    :func:`free_energy`) raised the total by more than ``ENERGY_GROWTH_TOL`` times the mean free
+    energy. Nothing in a scene without actuation adds energy: the gas and gravity are potentials;
+    damping, friction and the ground's constraints only remove it. Far too large implicit steps of a
+    nonlinear ring can converge to such spurious solutions; they are rejected and retried smaller."""
+    if not math.isfinite(after[0]):
         return True
-    return e1 - e0 > ENERGY_GROWTH_TOL * 0.5 * max(free, 0.0) + 1e-12 * abs(e0)
+    free = max(0.5 * (before[1] + after[1]), 0.0)
+    return after[0] - before[0] > ENERGY_GROWTH_TOL * free + 1e-12 * abs(before[0])
 
 
 @njit(cache=True)
@@ -354,6 +328,16 @@ def newton_ring(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active):
 
 
 @njit(cache=True)
+def initial_state_values(model, solver, state, ws):
+    """Fill what the stepper carries besides ``x, v``: every ring's energy and, for
+    generalized-alpha, its start acceleration."""
+    for r in range(state.x.shape[0]):
+        free_energy(model, r, state.x[r], state.v[r], ws.energy, state.energy[r])
+    if solver.method != METHOD_BACKWARD_EULER:
+        initial_acceleration(model, state.x, state.v, state.a, ws)
+
+
+@njit(cache=True)
 def initial_acceleration(model, x, v, a, ws):
     """``a = F(x, v) / m`` for every ring (the generalized-alpha start value)."""
     for r in range(x.shape[0]):
@@ -388,7 +372,10 @@ def try_step(model, solver, state, trial, h, ws):
             model, solver, r, state.x[r], state.v[r], state.a[r], h, trial.x[r], trial.v[r],
             trial.a[r], ws, trial.active[r],
         )  # fmt: skip
-        if its < 0 or _energy_grew(model, r, state.x[r], state.v[r], trial.x[r], trial.v[r], ws.energy):
+        if its < 0:
+            return -1, 0.0
+        free_energy(model, r, trial.x[r], trial.v[r], ws.energy, trial.energy[r])
+        if _energy_grew(state.energy[r], trial.energy[r]):
             return -1, 0.0
         total += its
         if contact:
@@ -438,6 +425,7 @@ def _accept(state, trial):
     state.a[:] = trial.a
     state.active[:] = trial.active
     state.contact_force[:] = trial.contact_force
+    state.energy[:] = trial.energy
 
 
 @njit(cache=True)

@@ -6,7 +6,7 @@ import pytest
 from ballenv.physics import Ground, Ring, Scene, simulate
 from ballenv.physics.model import build_model
 from ballenv.physics.simulate import initial_state
-from ballenv.physics.stepper import _energy_grew
+from ballenv.physics.stepper import _energy_grew, free_energy
 
 
 def _first_apex(**scene_kw):
@@ -51,7 +51,12 @@ def test_energy_guard_flags_a_step_that_adds_energy():
     x, v = initial_state(scene)
     parts = np.zeros(5)
     moving = v[0] + np.array([0.0, 0.05])  # kinetic energy from nowhere
-    assert not _energy_grew(model, 0, x[0], v[0], x[0], v[0], parts)
-    assert _energy_grew(model, 0, x[0], v[0], x[0], moving, parts)
-    assert not _energy_grew(model, 0, x[0], moving, x[0], v[0], parts)
-    assert _energy_grew(model, 0, x[0], v[0], x[0], np.full_like(moving, np.nan), parts)
+    at_rest, kicked, broken = np.zeros(2), np.zeros(2), np.zeros(2)
+    free_energy(model, 0, x[0], v[0], parts, at_rest)
+    free_energy(model, 0, x[0], moving, parts, kicked)
+    free_energy(model, 0, x[0], np.full_like(moving, np.nan), parts, broken)
+    assert at_rest[1] == pytest.approx(0.0, abs=1e-12 * at_rest[0])  # the inflated circle is the rest state
+    assert not _energy_grew(at_rest, at_rest)
+    assert _energy_grew(at_rest, kicked)
+    assert not _energy_grew(kicked, at_rest)
+    assert _energy_grew(at_rest, broken)

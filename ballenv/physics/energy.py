@@ -1,0 +1,38 @@
+"""Energy (J) of a ring: kinetic, stretching, bending, gas (the gas-law potential), gravity.
+
+Used by ``Trajectory.energy()`` and by the stepper's energy guard; ``Model.rest_energy`` is the
+value of the same sum (without gravity) on the ring's inflated circle at rest.
+"""
+
+from numba import njit
+
+from .elastic import bend_energy, stretch_energy
+from .loads import gas_energy, gravity_energy, polygon_area
+
+ENERGY_KINETIC = 0
+ENERGY_STRETCHING = 1
+ENERGY_BENDING = 2
+ENERGY_GAS = 3
+ENERGY_GRAVITY = 4
+ENERGY_PARTS = ("kinetic", "stretching", "bending", "gas", "gravity")
+
+
+@njit(cache=True)
+def ring_energy(model, r, x, v, parts):
+    """Energy (J) of ring ``r`` by part into ``parts`` (5,), in the order of ``ENERGY_PARTS``;
+    returns their sum."""
+    m = model.node_mass[r]
+    kinetic = 0.0
+    for i in range(x.shape[0]):
+        kinetic += v[i, 0] * v[i, 0] + v[i, 1] * v[i, 1]
+    parts[ENERGY_KINETIC] = 0.5 * m * kinetic
+    parts[ENERGY_STRETCHING] = stretch_energy(x, model.rest_len[r], model.ea[r])
+    parts[ENERGY_BENDING] = bend_energy(x, model.rest_len[r], model.ei[r], model.rest_turn[r])
+    parts[ENERGY_GAS] = 0.0
+    if model.pressurised[r]:
+        parts[ENERGY_GAS] = gas_energy(
+            polygon_area(x), model.gas_constant[r], model.gas_exponent, model.atmospheric_pressure,
+            model.width[r],
+        )  # fmt: skip
+    parts[ENERGY_GRAVITY] = gravity_energy(x, m, model.gravity) if model.use_gravity else 0.0
+    return parts.sum()
