@@ -71,6 +71,7 @@ class Workspace(NamedTuple):
     work: np.ndarray  # (2N, 1 + MAX_LOW_RANK)
     force: np.ndarray  # (N, 2)
     dx: np.ndarray  # (N, 2) displacement of the step, the Newton unknown
+    delta: np.ndarray  # (N, 2) the last Newton correction (for backtracking)
     xe: np.ndarray  # (N, 2)
     ve: np.ndarray  # (N, 2)
     reaction: np.ndarray  # (N,) normal ground reaction of the last solve (N)
@@ -215,6 +216,7 @@ def build_workspace(n_nodes):
         work=np.zeros((n2, 1 + MAX_LOW_RANK)),
         force=np.zeros((n_nodes, 2)),
         dx=np.zeros((n_nodes, 2)),
+        delta=np.zeros((n_nodes, 2)),
         xe=np.zeros((n_nodes, 2)),
         ve=np.zeros((n_nodes, 2)),
         reaction=np.zeros(n_nodes),

@@ -26,6 +26,7 @@ must stay below 1 (beyond, no wall tension can hold the gas).
 import math
 
 import numpy as np
+from numba import njit
 
 
 def rest_edge_length(radius, n_nodes):
@@ -63,16 +64,19 @@ def total_mass(ring):
     return ring.n_nodes * node_mass(ring)
 
 
+@njit(cache=True)
+def inflation_ratio_of(pressure, width, radius, n_nodes, ea):
+    """``q = p b R cos(pi / N) / EA`` (dimensionless) for gauge pressure ``p`` (Pa)."""
+    return pressure * width * radius * math.cos(math.pi / n_nodes) / ea
+
+
 def inflation_ratio(ring):
-    """``q = p b R cos(pi / N) / EA`` (dimensionless); 0 without gas. The inflated strain is q / (1 - q)."""
+    """``q`` of ``ring`` (see :func:`inflation_ratio_of`); 0 without gas. The inflated strain is
+    q / (1 - q)."""
     if not ring.pressure:
         return 0.0
-    return (
-        ring.pressure
-        * ring.width
-        * ring.radius
-        * math.cos(math.pi / ring.n_nodes)
-        / (stretching_stiffness(ring))
+    return inflation_ratio_of(
+        ring.pressure, ring.width, ring.radius, ring.n_nodes, stretching_stiffness(ring)
     )
 
 

@@ -60,3 +60,17 @@ def test_energy_guard_flags_a_step_that_adds_energy():
     assert _energy_grew(at_rest, kicked)
     assert not _energy_grew(kicked, at_rest)
     assert _energy_grew(at_rest, broken)
+
+
+def test_friction_on_arriving_nodes_does_not_stall_newton():
+    # regression: full Newton steps cycled on mu N s(v_t) of nodes arriving at 3 m/s (mu v_n / eps ~
+    # 150) and the step shrank to dt_min; backtracking converges
+    from ballenv.physics import Ground, Ring, Scene, simulate
+
+    scene = Scene(
+        rings=[Ring(radius=0.12, n_nodes=32, position=(0.0, 0.8))], grounds=[Ground(friction=0.5)],
+        adaptive=True, dt=1e-2, impulse_tol=5e-3,
+    )  # fmt: skip
+    traj = simulate(scene, 1.0)
+    assert traj.t[-1] == 1.0
+    assert len(traj.apexes()) == 1

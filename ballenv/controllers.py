@@ -1,0 +1,90 @@
+"""Scripted controllers for InflatedBall-v0: the heuristics that learned policies are measured against.
+
+Both read only the observation (through ``info["observation_structure"]``) and keep a little memory
+of the current bounce. Call ``reset()`` at each episode start and ``act(obs)`` at each step.
+"""
+
+import numpy as np
+
+
+class _Controller:
+    def __init__(self, structure, gravity=9.81):
+        self.s = structure
+        self.g = gravity
+        self.reset()
+
+    def reset(self):
+        pass
+
+    def _read(self, obs):
+        com = obs[self.s["centre_of_mass_position"]]
+        vel = obs[self.s["centre_of_mass_velocity"]]
+        force = float(obs[self.s["ground_normal_force"]].sum())
+        target = float(obs[self.s["target_height"]][0])
+        return float(com[1]), float(vel[1]), force > 0.0, target
+
+
+class PressurePump(_Controller):
+    """Pump gas like a child on a swing: more gas while the ball is on the ground or about to land
+    (the re-expanding ball does work ``p dA``), less in flight. The amplitude ``u`` in [-1, 1] is set
+    once per bounce, on the way up, from the flight apex ``y + vy^2 / 2g`` it predicts:
+    ``u = bias + gain (h_target - apex) / h_target`` (``bias``: the pumping that makes up a bounce's
+    loss at the target; negative ``u``, down to ``floor``: the reverse timing takes energy out, gently:
+    a ball knocked down to low bounces squashes too little to pump back up)."""
+
+    def __init__(self, structure, gravity=9.81, landing_height=0.35, gain=4.0, bias=0.7, floor=0.0):
+        super().__init__(structure, gravity)
+        self.landing_height = landing_height
+        self.gain = gain
+        self.bias = bias
+        self.floor = floor
+
+    def reset(self):
+        self.amplitude = 1.0
+
+    def act(self, obs):
+        y, vy, contact, target = self._read(obs)
+        if not contact and vy > 0.0:
+            apex = y + vy * vy / (2.0 * self.g)
+            self.amplitude = min(1.0, max(self.floor, self.bias + self.gain * (target - apex) / target))
+        landing = contact or (vy < 0.0 and y < self.landing_height)
+        return np.array([self.amplitude if landing else -self.amplitude], dtype=np.float32)
+
+
+class PaddleDribble(_Controller):
+    """Strike the ball once per flight as it falls through the paddle's reach, with the impulse
+    that restores the energy of a bounce to the target: a ball of mass ``m`` falling at ``v`` gains
+    ``v J + J^2 / 2m`` from an impulse ``J``; it needs ``m g (h_target - r) / retention - m g (apex -
+    r)``, ``retention`` being the fraction of its energy a bounce keeps."""
+
+    def __init__(self, structure, mass, gravity=9.81, retention=0.7, max_impulse=0.15):
+        super().__init__(structure, gravity)
+        self.mass = mass
+        self.retention = retention
+        self.max_impulse = max_impulse
+
+    def reset(self):
+        self.apex = None
+        self.struck = False
+
+    def act(self, obs):
+        y, vy, contact, target = self._read(obs)
+        idle = np.array([-1.0], dtype=np.float32)
+        if contact:
+            self.struck = False
+            return idle
+        if vy > 0.0:
+            self.apex = y + vy * vy / (2.0 * self.g)
+            return idle
+        in_reach = obs[self.s["paddle_in_reach"]][0] > 0.5
+        if self.struck or self.apex is None or not in_reach:
+            return idle
+        self.struck = True
+        m, g = self.mass, self.g
+        radius = float(np.abs(obs[self.s["node_position"]][1::2]).max())
+        needed = m * g * ((target - radius) / self.retention - (self.apex - radius))
+        if needed <= 0.0:
+            return idle
+        speed = -vy
+        impulse = m * (-speed + np.sqrt(speed * speed + 2.0 * needed / m))
+        return np.array([2.0 * min(1.0, impulse / self.max_impulse) - 1.0], dtype=np.float32)

@@ -1,0 +1,18 @@
+"""Gymnasium environments: InflatedBall-v0 (single) and its native vector env."""
+
+from gymnasium.envs.registration import register, registry
+
+ENV_ID = "InflatedBall-v0"
+MAX_EPISODE_STEPS = 1000
+
+
+def register_envs():
+    """Register InflatedBall-v0 (repeatable: a second call changes nothing)."""
+    if ENV_ID in registry:
+        return
+    register(
+        id=ENV_ID,
+        entry_point="ballenv.envs.inflated_ball:InflatedBallEnv",
+        vector_entry_point="ballenv.envs.vector:InflatedBallVectorEnv",
+        max_episode_steps=MAX_EPISODE_STEPS,
+    )

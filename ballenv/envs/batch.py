@@ -1,0 +1,472 @@
+"""Many bouncing balls advanced in one compiled call: the physics behind InflatedBall-v0.
+
+Every env holds one ring above one flat ground; the rings share material and numerical settings
+and differ in state, gas and target. One :class:`Model` with per-ring arrays of length E holds all
+envs; env ``e`` is advanced by the same ``stepper.advance`` as ``simulate()``, on views of its
+slices, with its own clock and step size. A batch of E envs therefore gives the same numbers as E
+batches of one (the single env is a batch of one).
+
+A control step of env ``e``: apply the action (set the gas, or let the paddle strike), advance to
+``(k + 1) * control_dt``, and tally the apex events of the interval. Only an apex in flight counts
+(after a lift-off, before the next touchdown): the centre of mass also turns round inside a squash.
+"""
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit
+
+from ..physics.actuation import apply_impulse, rest_circle_radius, restart, set_rest_pressure
+from ..physics.contact import FREE
+from ..physics.events import EVENT_APEX, EVENT_LIFTOFF, EVENT_TOUCHDOWN
+from ..physics.model import (
+    Model,
+    Recording,
+    State,
+    build_model,
+    build_solver,
+    build_workspace,
+    empty_state,
+)
+from ..physics.stepper import (
+    CLOCK_H,
+    CLOCK_T,
+    COUNT_EVENTS,
+    COUNT_RECORDS,
+    N_COUNTERS,
+    STATUS_BUFFER_FULL,
+    STATUS_DONE,
+    advance,
+    ring_pressure,
+)
+
+MODE_PRESSURE = 0
+MODE_PADDLE = 1
+END_NONE = 0
+END_REST = 1
+END_ARENA = 2
+END_FAILURE = 3
+END_REASONS = ("", "rest", "arena", "sim_failure")
+REWARD_TERMS = ("reward_apex", "reward_shaping", "reward_termination")
+NO_OUTPUT = 1e300  # output interval of advance(): record only at the end of the control step
+EVENT_ROWS = 32
+
+
+class Task(NamedTuple):
+    """The task's settings (scalars) and per-env values (arrays of length E)."""
+
+    mode: int
+    control_dt: float  # s
+    pressure_low: float  # Pa, gauge pressure at rest for action -1
+    pressure_high: float  # Pa, for action +1
+    pressure_rate: float  # Pa/s: the gas setpoint moves toward the command at most this fast
+    paddle_max_impulse: float  # N s, for action +1
+    paddle_reach: float  # m: the paddle strikes when the ball's top is within this of its height
+    paddle_depth: float  # m: it touches the nodes within this of the ball's top
+    ground_height: float  # m
+    gravity: float  # m/s^2
+    apex_weight: float
+    shaping_weight: float  # per second
+    termination_weight: float  # per missed apex
+    arena_half_width: float  # m
+    arena_height: float  # m
+    rest_height: float  # m
+    termination_horizon: float  # s: the termination term counts apexes missed until this time
+    target: np.ndarray  # (E,) m, target apex height of the centre of mass
+    setpoint: np.ndarray  # (E,) Pa, gas amount as gauge pressure at rest
+    rest_radius: np.ndarray  # (E,) m, radius of the inflated circle at the setpoint
+    paddle_height: np.ndarray  # (E,) m
+    airborne: np.ndarray  # (E,) bool: no ground contact since the last lift-off
+    steps: np.ndarray  # (E,) int64 control steps taken
+    apex_count: np.ndarray  # (E,) int64 flight apexes in the last control step
+    apex_error: np.ndarray  # (E,) sum of |h - target| / target over them
+    apex_height: np.ndarray  # (E,) m, the last of them (0 if none)
+    impulse: np.ndarray  # (E,) N s delivered by the paddle in the last control step
+    in_reach: np.ndarray  # (E,) bool: the paddle could strike at the start of the last step
+    status: np.ndarray  # (E,) int64 stepper status of the last control step
+    rise: np.ndarray  # (E,) m: height the ball could still rise (free energy over m g)
+    reward: np.ndarray  # (E, 4): reward and its terms apex, shaping, termination
+    end: np.ndarray  # (E,) int64: END_NONE, END_REST, END_ARENA or END_FAILURE
+
+
+@njit(cache=True)
+def env_model(model, e):
+    """The one-ring Model of env ``e`` (views of its slices)."""
+    s = slice(e, e + 1)
+    return Model(
+        model.node_mass[s], model.ea[s], model.ei[s], model.rest_len[s], model.rest_turn[s],
+        model.width[s], model.radius[s], model.pressurised[s], model.gas_constant[s],
+        model.gas_exponent, model.atmospheric_pressure, model.gravity, model.use_gravity,
+        model.damping, model.damping_mode, model.grounds, model.contact_method,
+        model.friction_regularization, model.impulse_tol, model.rest_energy[s],
+    )  # fmt: skip
+
+
+@njit(cache=True)
+def env_state(state, e):
+    """The one-ring State of env ``e`` (views of its slices)."""
+    s = slice(e, e + 1)
+    return State(state.x[s], state.v[s], state.a[s], state.active[s], state.contact_force[s], state.energy[s])
+
+
+@njit(cache=True)
+def reset_env(
+    model,
+    solver,
+    ws,
+    state,
+    clocks,
+    counters,
+    task,
+    e,
+    centre,
+    velocity,
+    phase,
+    target,
+    pressure,
+    obs,
+    low,
+    high,
+    out,
+):
+    """Put env ``e``'s ring on its inflated circle for gas ``pressure`` (Pa) at ``centre`` (m), turned
+    by ``phase`` (rad), moving rigidly with ``velocity`` (m/s); target apex ``target`` (m). Writes its
+    observation as :func:`step_batch` does."""
+    me = env_model(model, e)
+    se = env_state(state, e)
+    x = se.x[0]
+    v = se.v[0]
+    n = x.shape[0]
+    radius = model.radius[e]
+    if model.pressurised[e]:
+        radius = rest_circle_radius(me, 0, pressure, n)
+    for i in range(n):
+        theta = phase + 2.0 * math.pi * i / n
+        x[i, 0] = centre[0] + radius * math.cos(theta)
+        x[i, 1] = centre[1] + radius * math.sin(theta)
+        v[i, 0] = velocity[0]
+        v[i, 1] = velocity[1]
+        se.active[0, i] = FREE
+        se.contact_force[0, i, 0] = 0.0
+        se.contact_force[0, i, 1] = 0.0
+    if model.pressurised[e]:
+        set_rest_pressure(me, 0, pressure, x, v, se.a[0], se.active[0], se.energy[0], ws)
+    else:
+        restart(me, 0, x, v, se.a[0], se.active[0], se.energy[0], ws)
+    clocks[e, CLOCK_T] = 0.0
+    clocks[e, CLOCK_H] = solver.dt
+    counters[e, :] = 0
+    task.target[e] = target
+    task.setpoint[e] = pressure
+    task.rest_radius[e] = radius
+    task.paddle_height[e] = target + radius
+    task.airborne[e] = True
+    task.steps[e] = 0
+    task.apex_count[e] = 0
+    task.apex_error[e] = 0.0
+    task.apex_height[e] = 0.0
+    task.impulse[e] = 0.0
+    task.in_reach[e] = False
+    task.status[e] = STATUS_DONE
+    task.rise[e] = _rise(me, se, task, e)
+    task.reward[e, :] = 0.0
+    task.end[e] = END_NONE
+    observe_env(model, state, task, e, obs[e])
+    _clip(obs[e], low, high, out[e])
+
+
+@njit(cache=True)
+def _rise(me, se, task, e):
+    """Height (m) the ball's centre could still rise: free energy (kinetic, elastic and gas above the
+    inflated circle at rest) over ``m g``, plus the centre's height above its resting height."""
+    x = se.x[0]
+    n = x.shape[0]
+    cy = 0.0
+    for i in range(n):
+        cy += x[i, 1]
+    cy /= n
+    weight = n * me.node_mass[0] * task.gravity
+    return se.energy[0, 1] / weight + cy - task.ground_height - task.rest_radius[e]
+
+
+@njit(cache=True)
+def _actuate(me, se, task, e, action, ws, nodes):
+    x = se.x[0]
+    n = x.shape[0]
+    task.impulse[e] = 0.0
+    task.in_reach[e] = False
+    if task.mode == MODE_PRESSURE:
+        command = task.pressure_low + 0.5 * (action + 1.0) * (task.pressure_high - task.pressure_low)
+        most = task.pressure_rate * task.control_dt
+        pressure = task.setpoint[e] + min(most, max(-most, command - task.setpoint[e]))
+        if pressure != task.setpoint[e]:
+            set_rest_pressure(me, 0, pressure, x, se.v[0], se.a[0], se.active[0], se.energy[0], ws)
+            task.setpoint[e] = pressure
+            task.rest_radius[e] = rest_circle_radius(me, 0, pressure, n)
+        return
+    top = -math.inf
+    for i in range(n):
+        top = max(top, x[i, 1])
+    task.in_reach[e] = abs(top - task.paddle_height[e]) <= task.paddle_reach
+    impulse = 0.5 * (action + 1.0) * task.paddle_max_impulse
+    if not task.in_reach[e] or impulse <= 0.0:
+        return
+    count = 0
+    for i in range(n):
+        if x[i, 1] >= top - task.paddle_depth:
+            nodes[count] = i
+            count += 1
+    apply_impulse(me, 0, x, se.v[0], se.a[0], se.active[0], se.energy[0], ws, nodes, count, 0.0, -impulse)
+    task.impulse[e] = impulse
+
+
+@njit(cache=True)
+def _tally(task, e, events, n_events):
+    for k in range(n_events):
+        kind = int(events[k, 2])
+        if kind == EVENT_TOUCHDOWN:
+            task.airborne[e] = False
+        elif kind == EVENT_LIFTOFF:
+            task.airborne[e] = True
+        elif kind == EVENT_APEX and task.airborne[e]:
+            h = events[k, 3] - task.ground_height
+            task.apex_count[e] += 1
+            task.apex_error[e] += abs(h - task.target[e]) / task.target[e]
+            task.apex_height[e] = h
+
+
+@njit(cache=True)
+def step_batch(
+    model,
+    solver,
+    ws,
+    state,
+    trial,
+    clocks,
+    counters,
+    records,
+    events,
+    task,
+    actions,
+    active,
+    nodes,
+    obs,
+    low,
+    high,
+    out,
+):
+    """One control step of every env ``e`` with ``active[e]``: actuate with ``actions[e]`` in [-1, 1],
+    advance to its next control time, tally its flight apexes, then write its observation (``obs``,
+    unclipped; ``out``, clipped to ``[low, high]`` as float32) and reward and end (``task.reward``,
+    ``task.end``, see :func:`_outcome`)."""
+    for e in range(actions.shape[0]):
+        if not active[e]:
+            continue
+        me = env_model(model, e)
+        se = env_state(state, e)
+        te = env_state(trial, e)
+        task.apex_count[e] = 0
+        task.apex_error[e] = 0.0
+        task.apex_height[e] = 0.0
+        _actuate(me, se, task, e, actions[e], ws, nodes)
+        t_next = (task.steps[e] + 1) * task.control_dt
+        rec = Recording(
+            records.t[e], records.x[e], records.v[e], records.pressure[e], records.contact_force[e], events[e]
+        )
+        counters[e, COUNT_RECORDS] = 0
+        while True:
+            counters[e, COUNT_EVENTS] = 0
+            status = advance(me, solver, ws, se, te, clocks[e], counters[e], t_next, t_next, NO_OUTPUT, rec)
+            _tally(task, e, events[e], counters[e, COUNT_EVENTS])
+            if status != STATUS_BUFFER_FULL:
+                break
+        task.status[e] = status
+        task.steps[e] += 1
+        task.rise[e] = _rise(me, se, task, e)
+        observe_env(model, state, task, e, obs[e])
+        _clip(obs[e], low, high, out[e])
+        _outcome(task, e, obs[e], state.x.shape[1])
+
+
+@njit(cache=True)
+def _clip(row, low, high, out):
+    for k in range(row.shape[0]):
+        out[k] = min(high[k], max(low[k], row[k]))
+
+
+@njit(cache=True)
+def _outcome(task, e, row, n):
+    """Reward terms and end of env ``e`` after a control step (see ``InflatedBallEnv``'s Rewards):
+    apex ``-w sum |h - h_t| / h_t``; shaping ``-w dt |h_reach - h_t| / h_t`` with ``h_reach = r +
+    rise``; termination ``-w`` per apex left until ``termination_horizon`` (one per flight time
+    ``2 sqrt(2 (h_t - r) / g)``) when the ball rests, leaves the arena or the simulator fails."""
+    cx = row[4 * n]
+    cy = row[4 * n + 1]
+    target = task.target[e]
+    apex = -task.apex_weight * task.apex_error[e]
+    reach = task.rest_radius[e] + task.rise[e]
+    shaping = -task.shaping_weight * task.control_dt * abs(reach - target) / target
+    end = END_NONE
+    if task.status[e] != STATUS_DONE or cy < -1.0:
+        end = END_FAILURE
+    elif abs(cx) > task.arena_half_width or cy > task.arena_height:
+        end = END_ARENA
+    elif task.rise[e] < task.rest_height:
+        end = END_REST
+    termination = 0.0
+    if end != END_NONE:
+        flight = 2.0 * math.sqrt(2.0 * max(target - task.rest_radius[e], 1e-3) / task.gravity)
+        left = max(task.termination_horizon - task.steps[e] * task.control_dt, 0.0) / flight
+        termination = -task.termination_weight * left
+    task.end[e] = end
+    task.reward[e, 0] = apex + shaping + termination
+    task.reward[e, 1] = apex
+    task.reward[e, 2] = shaping
+    task.reward[e, 3] = termination
+
+
+@njit(cache=True)
+def observe_env(model, state, task, e, row):
+    """Write env ``e``'s observation (see InflatedBallEnv's table, unclipped) into ``row``."""
+    n = state.x.shape[1]
+    nx, ny = model.grounds[0, 0], model.grounds[0, 1]
+    x = state.x[e]
+    v = state.v[e]
+    cx = 0.0
+    cy = 0.0
+    ux = 0.0
+    uy = 0.0
+    for i in range(n):
+        cx += x[i, 0]
+        cy += x[i, 1]
+        ux += v[i, 0]
+        uy += v[i, 1]
+    cx /= n
+    cy /= n
+    ux /= n
+    uy /= n
+    for i in range(n):
+        row[2 * i] = x[i, 0] - cx
+        row[2 * i + 1] = x[i, 1] - cy
+        row[2 * n + 2 * i] = v[i, 0] - ux
+        row[2 * n + 2 * i + 1] = v[i, 1] - uy
+        f = state.contact_force[e, i]
+        row[4 * n + 4 + i] = f[0] * nx + f[1] * ny
+    row[4 * n] = cx
+    row[4 * n + 1] = cy - task.ground_height
+    row[4 * n + 2] = ux
+    row[4 * n + 3] = uy
+    k = 5 * n + 4
+    row[k] = ring_pressure(env_model(model, e), 0, x)
+    row[k + 1] = task.target[e]
+    if task.mode == MODE_PADDLE:
+        row[k + 2] = task.paddle_height[e]
+        row[k + 3] = 1.0 if task.in_reach[e] else 0.0
+        row[k + 4] = task.impulse[e]
+
+
+def observation_size(n_nodes, mode):
+    """Length of the observation vector."""
+    return 5 * n_nodes + 6 + (3 if mode == MODE_PADDLE else 0)
+
+
+def observation_structure(n_nodes, mode):
+    """Name -> slice of the observation vector (see InflatedBallEnv's observation table)."""
+    n = n_nodes
+    out = {
+        "node_position": slice(0, 2 * n),
+        "node_velocity": slice(2 * n, 4 * n),
+        "centre_of_mass_position": slice(4 * n, 4 * n + 2),
+        "centre_of_mass_velocity": slice(4 * n + 2, 4 * n + 4),
+        "ground_normal_force": slice(4 * n + 4, 5 * n + 4),
+        "pressure": slice(5 * n + 4, 5 * n + 5),
+        "target_height": slice(5 * n + 5, 5 * n + 6),
+    }
+    if mode == MODE_PADDLE:
+        out["paddle_height"] = slice(5 * n + 6, 5 * n + 7)
+        out["paddle_in_reach"] = slice(5 * n + 7, 5 * n + 8)
+        out["paddle_impulse"] = slice(5 * n + 8, 5 * n + 9)
+    return out
+
+
+class BallBatch:
+    """E envs' arrays and the compiled calls that reset and step them.
+
+    ``obs`` (E, D) float32 holds the observations clipped to ``[low, high]``; ``task.reward`` the
+    reward and its terms, ``task.end`` how each episode ended (``END_*``)."""
+
+    def __init__(self, scene, n_envs, task_settings, low, high):
+        self.scene = scene
+        self.n_envs = n_envs
+        self.n_nodes = scene.rings[0].n_nodes
+        self.model = _tiled_model(build_model(scene), n_envs)
+        self.solver = build_solver(scene)
+        self.ws = build_workspace(self.n_nodes)
+        self.state = empty_state(n_envs, self.n_nodes)
+        self.trial = empty_state(n_envs, self.n_nodes)
+        self.clocks = np.zeros((n_envs, 2))
+        self.counters = np.zeros((n_envs, N_COUNTERS), dtype=np.int64)
+        shape = (n_envs, 1, 1, self.n_nodes, 2)
+        self.records = Recording(
+            t=np.zeros((n_envs, 1)),
+            x=np.zeros(shape),
+            v=np.zeros(shape),
+            pressure=np.zeros((n_envs, 1, 1)),
+            contact_force=np.zeros(shape),
+            events=np.zeros((n_envs, EVENT_ROWS, 4)),
+        )
+        zeros = np.zeros(n_envs)
+        self.task = Task(
+            **task_settings,
+            target=zeros.copy(),
+            setpoint=zeros.copy(),
+            rest_radius=zeros.copy(),
+            paddle_height=zeros.copy(),
+            airborne=np.ones(n_envs, dtype=np.bool_),
+            steps=np.zeros(n_envs, dtype=np.int64),
+            apex_count=np.zeros(n_envs, dtype=np.int64),
+            apex_error=zeros.copy(),
+            apex_height=zeros.copy(),
+            impulse=zeros.copy(),
+            in_reach=np.zeros(n_envs, dtype=np.bool_),
+            status=np.zeros(n_envs, dtype=np.int64),
+            rise=zeros.copy(),
+            reward=np.zeros((n_envs, 4)),
+            end=np.zeros(n_envs, dtype=np.int64),
+        )
+        self.nodes = np.zeros(self.n_nodes, dtype=np.int64)
+        self.low = np.asarray(low, dtype=np.float64)
+        self.high = np.asarray(high, dtype=np.float64)
+        self.raw = np.zeros((n_envs, observation_size(self.n_nodes, self.task.mode)))
+        self.obs = np.zeros(self.raw.shape, dtype=np.float32)
+        self.all = np.ones(n_envs, dtype=np.bool_)
+
+    def reset(self, e, centre, velocity, phase, target, pressure):
+        """Start env ``e`` afresh (see :func:`reset_env`)."""
+        reset_env(
+            self.model, self.solver, self.ws, self.state, self.clocks, self.counters, self.task, e,
+            np.asarray(centre, dtype=float), np.asarray(velocity, dtype=float), float(phase),
+            float(target), float(pressure), self.raw, self.low, self.high, self.obs,
+        )  # fmt: skip
+
+    def step(self, actions, active=None):
+        """One control step of the envs marked in ``active`` (all by default); ``actions`` (E,)
+        float64 in [-1, 1]."""
+        step_batch(
+            self.model, self.solver, self.ws, self.state, self.trial, self.clocks, self.counters,
+            self.records, self.records.events, self.task, actions, self.all if active is None else active,
+            self.nodes, self.raw, self.low, self.high, self.obs,
+        )  # fmt: skip
+
+
+PER_RING_FIELDS = (
+    "node_mass", "ea", "ei", "rest_len", "rest_turn", "width", "radius", "pressurised", "gas_constant",
+    "rest_energy",
+)  # fmt: skip
+
+
+def _tiled_model(model, n_envs):
+    """``model`` of a one-ring scene with its per-ring arrays repeated for ``n_envs`` envs (the rings
+    of different envs never meet: this is not a scene of many rings)."""
+    return model._replace(**{name: np.repeat(getattr(model, name), n_envs) for name in PER_RING_FIELDS})

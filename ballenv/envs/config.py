@@ -1,0 +1,215 @@
+"""The keyword arguments of InflatedBall-v0, validated once, and what both envs derive from them:
+the physics scene, the task settings, the observation bounds, and the reward and episode end."""
+
+import math
+from dataclasses import dataclass, fields
+
+import numpy as np
+
+from ..physics import Ground, Ring, Scene
+from ..physics.presets import FIDELITY_PRESETS, with_fidelity
+from ..physics.ring import inflation_ratio_of
+from ..physics.scene import check_choice, check_real
+from ..physics.stepper import STATUS_IMPULSE_AT_DT_MIN, STATUS_STEP_TOO_SMALL
+from .batch import END_FAILURE, MODE_PADDLE, MODE_PRESSURE, observation_size
+
+ACTION_MODES = {"pressure": MODE_PRESSURE, "paddle": MODE_PADDLE}
+MAX_SPEED = 100.0  # m/s, bound of the velocity observations
+MAX_NODE_FORCE = 1e5  # N, bound of the per-node ground normal force observation
+MAX_PRESSURE = 1e7  # Pa, bound of the pressure observation
+FAILURES = {
+    STATUS_STEP_TOO_SMALL: "Newton's iteration failed down to the smallest step Scene.dt_min",
+    STATUS_IMPULSE_AT_DT_MIN: "the contact impulse stayed above impulse_tol at the smallest step",
+}
+
+
+@dataclass(frozen=True)
+class BallEnvConfig:
+    """Keyword arguments of InflatedBall-v0 (SI units); see the env's Arguments table."""
+
+    action_mode: str = "pressure"
+    fidelity: str = "fast"
+    control_frequency: float = 100.0
+    target_height_range: tuple = (0.5, 1.0)
+    start_height_range: tuple = (0.6, 1.2)
+    pressure_range: tuple = (10e3, 50e3)
+    initial_pressure: float = 30e3
+    pressure_rate: float = 4e5
+    paddle_max_impulse: float = 0.15
+    paddle_reach: float = 0.4
+    paddle_depth: float = 0.06
+    radius: float = 0.12
+    youngs_modulus: float = 10e6
+    thickness: float = 2e-3
+    width: float = 0.02
+    density: float = 1100.0
+    friction: float = 0.5
+    damping: float = 20.0
+    gravity: float = 9.81
+    apex_reward_weight: float = 1.0
+    shaping_reward_weight: float = 0.0
+    termination_reward_weight: float = 1.0
+    termination_horizon: float = 10.0
+    reset_noise_scale: float = 0.05
+    arena_half_width: float = 3.0
+    arena_height: float = 5.0
+    rest_height: float = 0.01
+
+    def __post_init__(self):
+        o = "InflatedBall-v0"
+        s = object.__setattr__
+        check_choice(o, "action_mode", self.action_mode, tuple(ACTION_MODES))
+        check_choice(o, "fidelity", self.fidelity, tuple(FIDELITY_PRESETS))
+        s(
+            self,
+            "control_frequency",
+            check_real(o, "control_frequency", self.control_frequency, 1.0, 1e4, "Hz"),
+        )
+        for name, lo, hi, unit in (
+            ("paddle_max_impulse", 0.0, 10.0, "N s"),
+            ("pressure_rate", 0.0, 1e12, "Pa/s"),
+            ("paddle_reach", 0.0, 10.0, "m"),
+            ("paddle_depth", 0.0, 10.0, "m"),
+            ("friction", 0.0, 10.0, ""),
+            ("damping", 0.0, 1e4, "1/s"),
+            ("apex_reward_weight", 0.0, 1e6, ""),
+            ("shaping_reward_weight", 0.0, 1e6, ""),
+            ("termination_reward_weight", 0.0, 1e6, ""),
+            ("reset_noise_scale", 0.0, 10.0, "m/s"),
+            ("rest_height", 0.0, 1.0, "m"),
+            ("termination_horizon", 0.0, 1e6, "s"),
+        ):
+            s(self, name, check_real(o, name, getattr(self, name), lo, hi, unit))
+        s(self, "gravity", check_real(o, "gravity", self.gravity, 0.0, 1000.0, "m/s^2", low_open=True))
+        s(self, "arena_half_width", check_real(o, "arena_half_width", self.arena_half_width, 0.1, 1e4, "m"))
+        s(self, "arena_height", check_real(o, "arena_height", self.arena_height, 0.1, 1e4, "m"))
+        # ring material: Ring validates it and the largest pressure (the wall's 100 % strain bound)
+        s(self, "pressure_range", _range(o, "pressure_range", self.pressure_range, 0.0, 1e8, "Pa"))
+        ring = self.ring(self.pressure_range[1])
+        s(self, "initial_pressure", check_real(o, "initial_pressure", self.initial_pressure, 0.0, 1e8, "Pa"))
+        self.ring(self.initial_pressure)
+        if self.action_mode == "pressure" and not (
+            self.pressure_range[0] <= self.initial_pressure <= self.pressure_range[1]
+        ):
+            raise ValueError(
+                f"{o}.initial_pressure = {self.initial_pressure!r} is out of range: must lie in "
+                f"pressure_range = {self.pressure_range} Pa"
+            )
+        low = 2.0 * ring.radius  # the centre of a resting ball is about one (inflated) radius up
+        for name in ("target_height_range", "start_height_range"):
+            s(self, name, _range(o, name, getattr(self, name), low, self.arena_height, "m"))
+
+    @property
+    def mode(self):
+        return ACTION_MODES[self.action_mode]
+
+    @property
+    def control_dt(self):
+        return 1.0 / self.control_frequency
+
+    @property
+    def n_nodes(self):
+        return FIDELITY_PRESETS[self.fidelity]["n_nodes"]
+
+    def ring(self, pressure):
+        """The ball as a physics Ring holding gas ``pressure`` (Pa) at rest."""
+        return Ring(
+            radius=self.radius, n_nodes=self.n_nodes, youngs_modulus=self.youngs_modulus,
+            thickness=self.thickness, width=self.width, density=self.density, pressure=pressure,
+        )  # fmt: skip
+
+    def scene(self):
+        """The physics scene of one env (its ring's state is set at every reset)."""
+        base = Scene(
+            rings=[self.ring(self.initial_pressure)],
+            grounds=[Ground(angle=0.0, height=0.0, friction=self.friction)],
+            gravity=self.gravity,
+            damping=self.damping,
+        )
+        return with_fidelity(base, self.fidelity)
+
+    def task_settings(self):
+        """The scalar fields of ``batch.Task``."""
+        return {
+            "mode": self.mode,
+            "control_dt": self.control_dt,
+            "pressure_low": float(self.pressure_range[0]),
+            "pressure_high": float(self.pressure_range[1]),
+            "pressure_rate": self.pressure_rate,
+            "paddle_max_impulse": self.paddle_max_impulse,
+            "paddle_reach": self.paddle_reach,
+            "paddle_depth": self.paddle_depth,
+            "ground_height": 0.0,
+            "gravity": self.gravity,
+            "apex_weight": self.apex_reward_weight,
+            "shaping_weight": self.shaping_reward_weight,
+            "termination_weight": self.termination_reward_weight,
+            "arena_half_width": self.arena_half_width,
+            "arena_height": self.arena_height,
+            "rest_height": self.rest_height,
+            "termination_horizon": self.termination_horizon,
+        }
+
+    def largest_radius(self):
+        """Radius (m) of the inflated circle at the largest pressure the env can set."""
+        ea = self.youngs_modulus * self.width * self.thickness
+        p = max(self.pressure_range[1], self.initial_pressure)
+        return self.radius / (1.0 - inflation_ratio_of(p, self.width, self.radius, self.n_nodes, ea))
+
+    def observation_bounds(self):
+        """(low, high) float32 bounds of the observation vector; observations are clipped to them."""
+        n = self.n_nodes
+        size = observation_size(n, self.mode)
+        reach = 4.0 * self.largest_radius()
+        low = np.empty(size)
+        high = np.empty(size)
+        low[: 2 * n], high[: 2 * n] = -reach, reach
+        low[2 * n : 4 * n], high[2 * n : 4 * n] = -MAX_SPEED, MAX_SPEED
+        low[4 * n : 4 * n + 2] = (-self.arena_half_width, -1.0)
+        high[4 * n : 4 * n + 2] = (self.arena_half_width, self.arena_height)
+        low[4 * n + 2 : 4 * n + 4], high[4 * n + 2 : 4 * n + 4] = -MAX_SPEED, MAX_SPEED
+        low[4 * n + 4 : 5 * n + 4], high[4 * n + 4 : 5 * n + 4] = 0.0, MAX_NODE_FORCE
+        k = 5 * n + 4
+        low[k], high[k] = -101325.0, MAX_PRESSURE
+        low[k + 1], high[k + 1] = self.target_height_range
+        if self.mode == MODE_PADDLE:
+            low[k + 2 : k + 5] = (0.0, 0.0, 0.0)
+            high[k + 2 : k + 5] = (self.arena_height + reach, 1.0, self.paddle_max_impulse)
+        return low.astype(np.float32), high.astype(np.float32)
+
+    @classmethod
+    def from_kwargs(cls, kwargs):
+        known = {f.name for f in fields(cls)}
+        unknown = sorted(set(kwargs) - known)
+        if unknown:
+            raise TypeError(
+                f"InflatedBall-v0 got unknown keyword arguments {unknown}; known: {sorted(known)}"
+            )
+        return cls(**kwargs)
+
+
+def _range(owner, name, value, low, high, unit):
+    valid = f"a pair (low, high) of finite numbers with {low:g} <= low < high <= {high:g} {unit}"
+    try:
+        lo, hi = (float(v) for v in value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{owner}.{name} = {value!r} is out of range: must be {valid}") from None
+    if not (math.isfinite(lo) and math.isfinite(hi) and low <= lo < hi <= high):
+        raise ValueError(f"{owner}.{name} = {value!r} is out of range: must be {valid}")
+    return (lo, hi)
+
+
+def draw_reset(config, rng):
+    """Start values of one episode from ``rng``: centre (m), velocity (m/s), phase (rad), target (m)."""
+    target = rng.uniform(*config.target_height_range)
+    height = rng.uniform(*config.start_height_range)
+    vx = rng.uniform(-config.reset_noise_scale, config.reset_noise_scale)
+    phase = rng.uniform(0.0, 2.0 * np.pi)
+    return (0.0, height), (vx, 0.0), phase, target
+
+
+def failure_message(task, e):
+    """Why env ``e``'s simulator stopped, or "" if it did not."""
+    if task.end[e] != END_FAILURE:
+        return ""
+    return FAILURES.get(int(task.status[e]), "the ball sank below the ground (tunnelling)")

@@ -1,0 +1,153 @@
+"""A native vector env of InflatedBall-v0: all balls stepped in one compiled call.
+
+``gym.make_vec("InflatedBall-v0", num_envs=64, vectorization_mode="vector_entry_point", **kwargs)``.
+Env ``i`` uses the random stream of a single env reset with ``seed + i`` (as ``SyncVectorEnv``
+seeds its envs) and the same compiled step, so it reproduces single envs exactly. Autoreset follows
+Gymnasium's default ``NEXT_STEP`` mode: the step after an episode ends resets that env, ignores its
+action and returns the first observation of the new episode with reward 0.
+"""
+
+import numpy as np
+from gymnasium import spaces
+from gymnasium.utils import seeding
+from gymnasium.vector import AutoresetMode, VectorEnv
+from gymnasium.vector.utils import batch_space
+
+from .batch import END_REASONS, REWARD_TERMS, BallBatch, observation_structure
+from .config import BallEnvConfig, draw_reset, failure_message
+from .inflated_ball import InflatedBallEnv
+
+DEFAULT_MAX_EPISODE_STEPS = 1000
+
+
+class InflatedBallVectorEnv(VectorEnv):
+    """``num_envs`` InflatedBall-v0 episodes advanced together (see :class:`InflatedBallEnv` for the
+    task, spaces and keyword arguments; ``max_episode_steps`` truncates each episode)."""
+
+    metadata = {
+        "render_modes": ["rgb_array"],
+        "render_fps": 50,
+        "autoreset_mode": AutoresetMode.NEXT_STEP,
+    }
+
+    def __init__(self, num_envs=1, max_episode_steps=DEFAULT_MAX_EPISODE_STEPS, render_mode=None, **kwargs):
+        if isinstance(num_envs, bool) or not isinstance(num_envs, int) or not 1 <= num_envs <= 100_000:
+            raise ValueError(
+                f"InflatedBall-v0.num_envs = {num_envs!r} is out of range: must be an integer in [1, 100000]"
+            )
+        if (
+            isinstance(max_episode_steps, bool)
+            or not isinstance(max_episode_steps, int)
+            or max_episode_steps < 1
+        ):
+            raise ValueError(
+                f"InflatedBall-v0.max_episode_steps = {max_episode_steps!r} is out of range: must be an "
+                "integer >= 1"
+            )
+        if render_mode not in (None, "rgb_array"):
+            raise ValueError(
+                f"InflatedBall-v0 vector render_mode = {render_mode!r} is out of range: must be None "
+                "or 'rgb_array'"
+            )
+        self.config = BallEnvConfig.from_kwargs(kwargs)
+        self.num_envs = num_envs
+        self.max_episode_steps = max_episode_steps
+        self.render_mode = render_mode
+        low, high = self.config.observation_bounds()
+        self._batch = BallBatch(self.config.scene(), num_envs, self.config.task_settings(), low, high)
+        self.single_observation_space = spaces.Box(low, high, dtype=np.float32)
+        self.single_action_space = spaces.Box(-1.0, 1.0, shape=(1,), dtype=np.float32)
+        self.observation_space = batch_space(self.single_observation_space, num_envs)
+        self.action_space = batch_space(self.single_action_space, num_envs)
+        self._structure = observation_structure(self.config.n_nodes, self.config.mode)
+        self._rngs = [seeding.np_random()[0] for _ in range(num_envs)]
+        self._autoreset = np.zeros(num_envs, dtype=np.bool_)
+        self._actions = np.zeros(num_envs)
+        self._renderer = None
+
+    def reset(self, *, seed=None, options=None):
+        super().reset(seed=seed)
+        if seed is None:
+            seeds = [None] * self.num_envs
+        elif isinstance(seed, int):
+            seeds = [seed + i for i in range(self.num_envs)]
+        else:
+            seeds = list(seed)
+            if len(seeds) != self.num_envs:
+                raise ValueError(
+                    f"InflatedBall-v0 vector reset seed has {len(seeds)} entries: must have "
+                    f"num_envs = {self.num_envs}"
+                )
+        for i, s in enumerate(seeds):
+            self._rngs[i], _ = seeding.np_random(s)
+            self._reset_env(i)
+        self._autoreset[:] = False
+        info = {
+            "observation_structure": dict(self._structure),
+            "target_height": self._batch.task.target.copy(),
+            "time": np.zeros(self.num_envs),
+        }
+        return self._batch.obs.copy(), info
+
+    def _reset_env(self, i):
+        centre, velocity, phase, target = draw_reset(self.config, self._rngs[i])
+        self._batch.reset(i, centre, velocity, phase, target, self.config.initial_pressure)
+
+    def step(self, actions):
+        a = np.asarray(actions, dtype=np.float64).reshape(-1)
+        if a.shape != (self.num_envs,) or not np.all(np.isfinite(a)):
+            raise ValueError(
+                f"InflatedBall-v0 vector step actions of shape {np.shape(actions)} are invalid: must be "
+                f"{self.num_envs} finite numbers, shape ({self.num_envs}, 1)"
+            )
+        np.clip(a, -1.0, 1.0, out=self._actions)
+        resetting = self._autoreset.copy()
+        batch = self._batch
+        batch.step(self._actions, ~resetting)
+        for i in np.flatnonzero(resetting):
+            self._reset_env(i)
+        task = batch.task
+        stepped = ~resetting
+        terminated = (task.end != 0) & stepped
+        truncated = (task.steps >= self.max_episode_steps) & stepped
+        reward = np.where(stepped, task.reward[:, 0], 0.0)
+        self._autoreset = terminated | truncated
+        return batch.obs.copy(), reward, terminated, truncated, self._step_info(stepped)
+
+    def _step_info(self, stepped):
+        task = self._batch.task
+        info = {name: np.where(stepped, task.reward[:, k + 1], 0.0) for k, name in enumerate(REWARD_TERMS)}
+        reasons = np.array(
+            [END_REASONS[int(c)] if s else "" for c, s in zip(task.end, stepped, strict=True)], dtype=object
+        )
+        info.update(
+            time=task.steps * self.config.control_dt,
+            apex_count=np.where(stepped, task.apex_count, 0),
+            apex_height=np.where(stepped, task.apex_height, 0.0),
+            target_height=task.target.copy(),
+            pressure_setpoint=task.setpoint.copy(),
+            paddle_impulse=np.where(stepped, task.impulse, 0.0),
+            termination=reasons,
+            sim_failure=reasons == "sim_failure",
+            sim_failure_reason=np.array(
+                [failure_message(task, i) if s else "" for i, s in enumerate(stepped)], dtype=object
+            ),
+        )
+        return info
+
+    def render(self):
+        if self.render_mode is None:
+            return None
+        if self._renderer is None:
+            from ..render import BallRenderer
+
+            self._renderer = BallRenderer(self.config, "rgb_array", self.metadata["render_fps"])
+        return tuple(self._renderer.render(self._batch, i) for i in range(self.num_envs))
+
+    def close_extras(self, **kwargs):
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
+
+
+__all__ = ["InflatedBallEnv", "InflatedBallVectorEnv"]

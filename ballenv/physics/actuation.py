@@ -1,0 +1,87 @@
+"""Actuation between steps: the amount of gas in a ring, and impulses on its nodes.
+
+Both change a ring's energy on purpose, so each recomputes what the stepper carries for the ring
+(its energy and free energy for the energy guard, which then compares only steps without
+actuation, and the generalized-alpha start acceleration ``a = F / m``, as at a restart).
+
+* :func:`set_rest_pressure`: the gas is set to the amount whose gauge pressure on the ring's inflated
+  circle at rest is ``p`` (Pa), i.e. ``(p + p_atm) A_r^k`` with ``A_r`` the area of that circle
+  (radius ``R / (1 - q)``, :mod:`ring`). The gas law then sets the pressure as the ring deforms:
+  raising ``p`` while the ball is squashed does work ``int p dA`` on the ring as it re-expands.
+* :func:`apply_impulse`: a momentum ``J`` (N s) shared equally by chosen nodes (equal masses), so
+  the ring's momentum changes by exactly ``J``.
+"""
+
+import math
+
+from numba import njit
+
+from .contact import FREE
+from .energy import ENERGY_GRAVITY, ring_energy
+from .loads import polygon_area
+from .ring import inflation_ratio_of
+from .stepper import free_energy, ring_force
+
+
+@njit(cache=True)
+def rest_circle_radius(model, r, pressure, n_nodes):
+    """Radius (m) of ring ``r``'s inflated circle at rest for gauge pressure ``pressure`` (Pa)."""
+    q = inflation_ratio_of(pressure, model.width[r], model.radius[r], n_nodes, model.ea[r])
+    return model.radius[r] / (1.0 - q)
+
+
+@njit(cache=True)
+def set_rest_pressure(model, r, pressure, x, v, a, active, energy, ws):
+    """Set ring ``r``'s gas to the amount with gauge pressure ``pressure`` (Pa) at rest (see module
+    doc): updates ``model.gas_constant[r]`` and ``model.rest_energy[r]``, then the ring's carried
+    ``energy`` (2,) and start acceleration ``a`` (N, 2) for state ``x, v`` with contact set
+    ``active``. ``ws.xe``/``ws.ve`` are used as scratch."""
+    n = x.shape[0]
+    radius = rest_circle_radius(model, r, pressure, n)
+    circle = ws.xe
+    still = ws.ve
+    for i in range(n):
+        theta = 2.0 * math.pi * i / n
+        circle[i, 0] = radius * math.cos(theta)
+        circle[i, 1] = radius * math.sin(theta)
+        still[i, 0] = 0.0
+        still[i, 1] = 0.0
+    area = polygon_area(circle)
+    model.gas_constant[r] = (pressure + model.atmospheric_pressure) * area**model.gas_exponent
+    total = ring_energy(model, r, circle, still, ws.energy)
+    model.rest_energy[r] = total - ws.energy[ENERGY_GRAVITY]
+    restart(model, r, x, v, a, active, energy, ws)
+
+
+@njit(cache=True)
+def apply_impulse(model, r, x, v, a, active, energy, ws, nodes, count, jx, jy):
+    """Add momentum ``(jx, jy)`` (N s) to ring ``r``, shared equally by ``nodes[:count]``."""
+    if count == 0:
+        return
+    dvx = jx / (count * model.node_mass[r])
+    dvy = jy / (count * model.node_mass[r])
+    for k in range(count):
+        i = nodes[k]
+        v[i, 0] += dvx
+        v[i, 1] += dvy
+    restart(model, r, x, v, a, active, energy, ws)
+
+
+@njit(cache=True)
+def restart(model, r, x, v, a, active, energy, ws):
+    """Recompute ring ``r``'s carried energy and start acceleration ``a = F / m`` (normal part zeroed
+    on ground-constrained nodes, which rest on the surface) after an actuation."""
+    free_energy(model, r, x, v, ws.energy, energy)
+    ring_force(model, r, x, v, ws.force)
+    m = model.node_mass[r]
+    for i in range(x.shape[0]):
+        ax = ws.force[i, 0] / m
+        ay = ws.force[i, 1] / m
+        g = active[i]
+        if g != FREE:
+            nx, ny = model.grounds[g, 0], model.grounds[g, 1]
+            an = ax * nx + ay * ny
+            ax -= an * nx
+            ay -= an * ny
+        a[i, 0] = ax
+        a[i, 1] = ay

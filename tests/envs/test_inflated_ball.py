@@ -1,0 +1,148 @@
+"""InflatedBall-v0 as Gymnasium and Stable-Baselines3 expect it: checkers, seeding, pickling,
+bounds under extreme actions, clear errors."""
+
+import pickle
+import warnings
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+
+import ballenv  # noqa: F401  (registers the env)
+from ballenv.envs.inflated_ball import InflatedBallEnv
+
+MODES = ("pressure", "paddle")
+
+
+@pytest.mark.parametrize("mode", MODES)
+@pytest.mark.parametrize("render_mode", [None, "rgb_array", "human"])
+def test_gymnasium_check_env_passes_with_warnings_as_errors(mode, render_mode):
+    env = gym.make("InflatedBall-v0", action_mode=mode, render_mode=render_mode)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_env(env.unwrapped, skip_render_check=False)
+    env.close()
+
+
+@pytest.mark.parametrize("mode", MODES)
+def test_stable_baselines3_check_env_passes(mode):
+    sb3_checker = pytest.importorskip("stable_baselines3.common.env_checker")
+    env = InflatedBallEnv(action_mode=mode)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        sb3_checker.check_env(env, warn=True)
+
+
+def test_registered_under_both_ids_with_a_time_limit():
+    for env_id in ("InflatedBall-v0", "ballenv:InflatedBall-v0"):
+        env = gym.make(env_id)
+        assert env.spec.max_episode_steps == 1000
+        assert isinstance(env.unwrapped, InflatedBallEnv)
+    ballenv.register_envs()  # repeatable
+    assert gym.spec("InflatedBall-v0").entry_point == "ballenv.envs.inflated_ball:InflatedBallEnv"
+
+
+def _rollout(env, seed, steps, actions=None):
+    obs, _ = env.reset(seed=seed)
+    env.action_space.seed(seed)
+    out = [obs]
+    rewards = []
+    for k in range(steps):
+        a = env.action_space.sample() if actions is None else actions[k]
+        obs, reward, terminated, truncated, _ = env.step(a)
+        out.append(obs)
+        rewards.append(reward)
+        if terminated or truncated:
+            obs, _ = env.reset()
+            out.append(obs)
+    return np.array(out), np.array(rewards)
+
+
+@pytest.mark.parametrize("mode", MODES)
+def test_same_seed_gives_identical_rollouts(mode):
+    a = _rollout(gym.make("InflatedBall-v0", action_mode=mode), 7, 200)
+    b = _rollout(gym.make("InflatedBall-v0", action_mode=mode), 7, 200)
+    np.testing.assert_array_equal(a[0], b[0])
+    np.testing.assert_array_equal(a[1], b[1])
+    c = _rollout(gym.make("InflatedBall-v0", action_mode=mode), 8, 200)
+    assert not np.array_equal(a[0][0], c[0][0])
+
+
+def test_pickle_round_trip_keeps_the_arguments_and_the_dynamics():
+    env = InflatedBallEnv(action_mode="paddle", target_height_range=(0.6, 0.7), damping=5.0)
+    clone = pickle.loads(pickle.dumps(env))
+    assert clone.config == env.config
+    actions = np.random.default_rng(0).uniform(-1, 1, (150, 1)).astype(np.float32)
+    a = _rollout(env, 3, 150, actions)
+    b = _rollout(clone, 3, 150, actions)
+    np.testing.assert_array_equal(a[0], b[0])
+
+
+def test_step_returns_new_arrays_and_python_scalars():
+    env = InflatedBallEnv()
+    first, _ = env.reset(seed=0)
+    obs, reward, terminated, truncated, info = env.step(np.array([0.2], dtype=np.float32))
+    assert obs is not first and not np.shares_memory(obs, first)
+    assert type(reward) is float and type(terminated) is bool and type(truncated) is bool
+    structure = info["observation_structure"]
+    assert sum(s.stop - s.start for s in structure.values()) == env.observation_space.shape[0]
+    terms = [v for k, v in info.items() if k.startswith("reward_")]
+    assert reward == pytest.approx(sum(terms), abs=1e-12)
+
+
+@pytest.mark.parametrize("mode", MODES)
+@pytest.mark.parametrize("pattern", ["plus", "minus", "alternating"])
+def test_extreme_actions_for_10000_steps_keep_observations_finite_and_in_bounds(mode, pattern):
+    env = gym.make("InflatedBall-v0", action_mode=mode)
+    space = env.observation_space
+    obs, _ = env.reset(seed=11)
+    ends = {}
+    for k in range(10_000):
+        value = {"plus": 1.0, "minus": -1.0, "alternating": 1.0 if k % 2 else -1.0}[pattern]
+        obs, reward, terminated, truncated, info = env.step(np.array([value], dtype=np.float32))
+        assert np.all(np.isfinite(obs)) and space.contains(obs), (k, info)
+        assert np.isfinite(reward)
+        if terminated or truncated:
+            ends[info["termination"] or "time_limit"] = ends.get(info["termination"] or "time_limit", 0) + 1
+            obs, _ = env.reset()
+    assert "sim_failure" not in ends, ends
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "field"),
+    [
+        ({"action_mode": "kick"}, "action_mode"),
+        ({"fidelity": "ultra"}, "fidelity"),
+        ({"control_frequency": float("nan")}, "control_frequency"),
+        ({"target_height_range": (1.0, 0.5)}, "target_height_range"),
+        ({"pressure_range": (10e3, 1e9)}, "pressure_range"),
+        ({"initial_pressure": 5e3}, "initial_pressure"),
+        ({"youngs_modulus": -1.0}, "youngs_modulus"),
+        ({"render_mode": "ascii"}, "render_mode"),
+    ],
+)
+def test_invalid_arguments_raise_value_error_naming_the_field(kwargs, field):
+    with pytest.raises(ValueError, match=field):
+        InflatedBallEnv(**kwargs)
+
+
+def test_invalid_action_raises_and_out_of_range_actions_are_clipped():
+    env = InflatedBallEnv()
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="action"):
+        env.step(np.array([np.nan], dtype=np.float32))
+    env.step(np.array([5.0], dtype=np.float32))
+    assert env._batch.task.setpoint[0] == pytest.approx(30e3 + env.config.pressure_rate * env.dt)
+
+
+def test_rgb_array_render_is_an_image_and_opens_no_window():
+    import pygame
+
+    env = gym.make("InflatedBall-v0", action_mode="paddle", render_mode="rgb_array")
+    env.reset(seed=0)
+    env.step(np.array([1.0], dtype=np.float32))
+    frame = env.render()
+    assert frame.dtype == np.uint8 and frame.ndim == 3 and frame.shape[2] == 3
+    assert len(np.unique(frame.reshape(-1, 3), axis=0)) > 3  # ring, ground, text drawn
+    assert not pygame.display.get_init()

@@ -1,0 +1,104 @@
+"""The native vector env against single envs, and Gymnasium's own vectorisations."""
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import ballenv  # noqa: F401  (registers the env)
+from ballenv.envs.vector import InflatedBallVectorEnv
+
+
+def _single_rollouts(n_envs, seed, actions, env_id="InflatedBall-v0", **kwargs):
+    """Step n single envs as Gymnasium's NEXT_STEP autoreset does: the step after an episode ends
+    resets that env and returns reward 0."""
+    envs = [gym.make(env_id, **kwargs) for _ in range(n_envs)]
+    obs = [np.stack([e.reset(seed=seed + i)[0] for i, e in enumerate(envs)])]
+    rewards, terms, truncs = [], [], []
+    done = np.zeros(n_envs, dtype=bool)
+    for a in actions:
+        step = []
+        for i, e in enumerate(envs):
+            if done[i]:
+                step.append((e.reset()[0], 0.0, False, False))
+            else:
+                o, r, te, tr, _ = e.step(a[i])
+                step.append((o, r, te, tr))
+        obs.append(np.stack([s[0] for s in step]))
+        rewards.append([s[1] for s in step])
+        terms.append([s[2] for s in step])
+        truncs.append([s[3] for s in step])
+        done = np.array(terms[-1]) | np.array(truncs[-1])
+    return np.array(obs), np.array(rewards), np.array(terms), np.array(truncs)
+
+
+def _vector_rollouts(venv, seed, actions):
+    obs = [venv.reset(seed=seed)[0]]
+    rewards, terms, truncs = [], [], []
+    for a in actions:
+        o, r, te, tr, _ = venv.step(a)
+        obs.append(o)
+        rewards.append(r)
+        terms.append(te)
+        truncs.append(tr)
+    return np.array(obs), np.array(rewards), np.array(terms), np.array(truncs)
+
+
+def _actions(n_steps, n_envs, seed=0):
+    return np.random.default_rng(seed).uniform(-1, 1, (n_steps, n_envs, 1)).astype(np.float32)
+
+
+@pytest.mark.parametrize("mode", ["pressure", "paddle"])
+def test_native_vector_env_matches_single_envs_through_autoresets(mode):
+    # a short time limit so that episodes end (truncation and termination) and autoreset
+    n_envs, steps = 4, 400
+    actions = _actions(steps, n_envs)
+    venv = gym.make_vec(
+        "InflatedBall-v0", num_envs=n_envs, vectorization_mode="vector_entry_point", action_mode=mode,
+        max_episode_steps=150,
+    )  # fmt: skip
+    assert isinstance(venv.unwrapped, InflatedBallVectorEnv)
+    vec = _vector_rollouts(venv, 5, actions)
+    single = _single_rollouts(n_envs, 5, actions, action_mode=mode, max_episode_steps=150)
+    np.testing.assert_allclose(vec[0], single[0], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(vec[1], single[1], rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(vec[2], single[2])
+    np.testing.assert_array_equal(vec[3], single[3])
+    assert vec[3].sum() >= n_envs  # every env was truncated at least once
+
+
+def test_sync_vector_env_matches_single_envs():
+    actions = _actions(120, 2, seed=1)
+    venv = gym.make_vec("InflatedBall-v0", num_envs=2, vectorization_mode="sync")
+    vec = _vector_rollouts(venv, 9, actions)
+    single = _single_rollouts(2, 9, actions)
+    np.testing.assert_array_equal(vec[0], single[0])
+    np.testing.assert_array_equal(vec[1], single[1])
+
+
+def test_async_spawned_vector_env_matches_single_envs():
+    actions = _actions(60, 2, seed=2)
+    venv = gym.make_vec(
+        "ballenv:InflatedBall-v0", num_envs=2, vectorization_mode="async", vector_kwargs={"context": "spawn"}
+    )
+    try:
+        vec = _vector_rollouts(venv, 4, actions)
+    finally:
+        venv.close()
+    single = _single_rollouts(2, 4, actions)
+    np.testing.assert_array_equal(vec[0], single[0])
+    np.testing.assert_array_equal(vec[1], single[1])
+
+
+def test_vector_env_spaces_and_errors():
+    venv = InflatedBallVectorEnv(num_envs=3)
+    obs, info = venv.reset(seed=0)
+    assert venv.observation_space.contains(obs)
+    assert info["target_height"].shape == (3,)
+    with pytest.raises(ValueError, match="actions"):
+        venv.step(np.zeros((2, 1), dtype=np.float32))
+    with pytest.raises(ValueError, match="num_envs"):
+        InflatedBallVectorEnv(num_envs=0)
+    frames = InflatedBallVectorEnv(num_envs=2, render_mode="rgb_array")
+    frames.reset(seed=0)
+    images = frames.render()
+    assert len(images) == 2 and images[0].dtype == np.uint8
