@@ -114,3 +114,45 @@ class BallRenderer:
         if self.window is not None:
             self.pygame.display.quit()
             self.window = None
+
+
+def frame_strip(out, steps=(0, 30, 36, 42, 90), seed=3):
+    """Write a PNG strip of frames of both action modes under their scripted controllers."""
+    import gymnasium as gym
+
+    from .controllers import PaddleDribble, PressurePump
+    from .physics.ring import total_mass
+
+    rows = []
+    for mode in ("pressure", "paddle"):
+        env = gym.make("InflatedBall-v0", action_mode=mode, render_mode="rgb_array")
+        obs, info = env.reset(seed=seed)
+        config = env.unwrapped.config
+        if mode == "pressure":
+            controller = PressurePump(info["observation_structure"])
+        else:
+            mass = total_mass(config.ring(config.initial_pressure))
+            controller = PaddleDribble(
+                info["observation_structure"], mass, max_impulse=config.paddle_max_impulse
+            )
+        frames = []
+        for k in range(max(steps) + 1):
+            if k in steps:
+                frames.append(env.render())
+            obs, *_ = env.step(controller.act(obs))
+        rows.append(np.concatenate(frames, axis=1))
+        env.close()
+    image = np.concatenate(rows, axis=0)
+    pg = _pygame()
+    pg.image.save(pg.surfarray.make_surface(np.transpose(image, (1, 0, 2))), str(out))
+    return out
+
+
+if __name__ == "__main__":
+    import argparse
+    import os
+
+    os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+    parser = argparse.ArgumentParser(description="Write a frame strip of InflatedBall-v0 (both modes).")
+    parser.add_argument("--out", default="docs/env.png", help="PNG file to write")
+    print(frame_strip(parser.parse_args().out))

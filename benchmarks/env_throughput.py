@@ -1,0 +1,190 @@
+"""Throughput of InflatedBall-v0: env steps per second per fidelity preset and action mode, the native
+vector env against Gymnasium's SyncVectorEnv, and each preset's first-apex error.
+
+    python benchmarks/env_throughput.py    # writes benchmarks/results/env_throughput.md and .png
+
+Single process, numba warm (one warm-up episode), OPENBLAS_NUM_THREADS=1. Policies: "scripted" is
+the heuristic controller of the mode (a ball that keeps bouncing: the workload of a trained agent),
+"random" draws uniform actions (a learner's first episodes; violent for the pressure mode, whose
+random pumping rings the ball). Steps/s counts env steps including resets; best of 3 repeats.
+
+Preset error: first apex of a ball (R = 0.12 m, E = 10 MPa, h = 2 mm, 30 kPa, friction 0.5) dropped
+from 1 m, against a reference at N = 128, dt <= 1e-3 s, impulse_tol = 1e-4 N s.
+"""
+
+import os
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import pathlib  # noqa: E402
+import time  # noqa: E402
+
+import gymnasium as gym  # noqa: E402
+import numpy as np  # noqa: E402
+from tqdm.auto import tqdm  # noqa: E402
+
+import ballenv  # noqa: E402, F401
+from ballenv.controllers import PaddleDribble, PressurePump  # noqa: E402
+from ballenv.physics import Ground, Ring, Scene, simulate  # noqa: E402
+from ballenv.physics.presets import FIDELITY_PRESETS, with_fidelity  # noqa: E402
+from ballenv.physics.ring import total_mass  # noqa: E402
+
+RESULTS = pathlib.Path(__file__).parent / "results"
+PRESETS = tuple(FIDELITY_PRESETS)
+MODES = ("pressure", "paddle")
+SINGLE_STEPS = 2000
+VECTOR_SIZES = (1, 8, 64)
+VECTOR_ENV_STEPS = 6400  # env steps per vector measurement (split over the envs)
+
+
+def controller(env, mode, structure):
+    config = env.unwrapped.config
+    if mode == "pressure":
+        return PressurePump(structure)
+    mass = total_mass(config.ring(config.initial_pressure))
+    return PaddleDribble(structure, mass, max_impulse=config.paddle_max_impulse)
+
+
+def single_rate(preset, mode, policy, repeats=3):
+    env = gym.make("InflatedBall-v0", action_mode=mode, fidelity=preset)
+    obs, info = env.reset(seed=0)
+    ctrl = controller(env, mode, info["observation_structure"])
+    env.action_space.seed(0)
+    for _ in range(50):  # warm-up (compiles on the first run)
+        obs, *_ = env.step(env.action_space.sample())
+    best = 0.0
+    for rep in range(repeats):
+        obs, _ = env.reset(seed=rep)
+        ctrl.reset()
+        start = time.perf_counter()
+        for _ in range(SINGLE_STEPS):
+            action = env.action_space.sample() if policy == "random" else ctrl.act(obs)
+            obs, _, terminated, truncated, _ = env.step(action)
+            if terminated or truncated:
+                obs, _ = env.reset()
+                ctrl.reset()
+        best = max(best, SINGLE_STEPS / (time.perf_counter() - start))
+    return best
+
+
+def vector_rate(n_envs, mode, native, repeats=3):
+    kind = "vector_entry_point" if native else "sync"
+    venv = gym.make_vec("InflatedBall-v0", num_envs=n_envs, vectorization_mode=kind, action_mode=mode)
+    rng = np.random.default_rng(0)
+    steps = max(1, VECTOR_ENV_STEPS // n_envs)
+    venv.reset(seed=0)
+    for _ in range(5):
+        venv.step(rng.uniform(-1, 1, (n_envs, 1)).astype(np.float32))
+    best = 0.0
+    for rep in range(repeats):
+        venv.reset(seed=rep)
+        actions = rng.uniform(-1, 1, (steps, n_envs, 1)).astype(np.float32)
+        start = time.perf_counter()
+        for a in actions:
+            venv.step(a)
+        best = max(best, steps * n_envs / (time.perf_counter() - start))
+    venv.close()
+    return best
+
+
+def drop_scene():
+    ring = Ring(
+        radius=0.12, n_nodes=64, youngs_modulus=10e6, thickness=2e-3, pressure=30e3, position=(0.0, 1.0)
+    )
+    return Scene(rings=[ring], grounds=[Ground(friction=0.5)])
+
+
+def preset_errors():
+    """{preset: (first apex m, relative error, wall s)} and the reference apex."""
+    base = drop_scene()
+    reference_scene = with_fidelity(base, "accurate")
+    reference_scene = reference_scene.__class__(
+        **{**reference_scene.__dict__, "dt": 1e-3, "impulse_tol": 1e-4, "newton_tol": 1e-10}
+    )
+    reference = simulate(reference_scene, 0.9).apexes()[0, 1]
+    out = {}
+    for preset in PRESETS:
+        sc = with_fidelity(base, preset)
+        simulate(sc, 0.05)
+        walls = []
+        for _ in range(3):
+            traj = simulate(sc, 0.9)
+            walls.append(traj.stats.wall_time)
+        apex = traj.apexes()[0, 1]
+        out[preset] = (apex, abs(apex - reference) / reference, float(np.median(walls)))
+    return out, reference
+
+
+def main():
+    RESULTS.mkdir(exist_ok=True)
+    lines = [
+        "# InflatedBall-v0 throughput",
+        "",
+        f"Single env, {SINGLE_STEPS} steps, best of 3 (env steps/s):",
+        "",
+    ]
+    lines += ["| preset | mode | scripted policy | random actions |", "|---|---|---:|---:|"]
+    single = {}
+    for preset in tqdm(PRESETS, desc="single env"):
+        for mode in MODES:
+            single[preset, mode] = (
+                single_rate(preset, mode, "scripted"),
+                single_rate(preset, mode, "random"),
+            )
+            s, r = single[preset, mode]
+            lines.append(f"| {preset} | {mode} | {s:,.0f} | {r:,.0f} |")
+    lines += ["", "Vector envs, fast preset, random actions (env steps/s, all envs together):", ""]
+    lines += ["| mode | envs | native vector env | SyncVectorEnv | ratio |", "|---|---:|---:|---:|---:|"]
+    vector = {}
+    for mode in MODES:
+        for n in tqdm(VECTOR_SIZES, desc=f"vector {mode}"):
+            native = vector_rate(n, mode, True)
+            sync = vector_rate(n, mode, False)
+            vector[mode, n] = (native, sync)
+            lines.append(f"| {mode} | {n} | {native:,.0f} | {sync:,.0f} | {native / sync:.2f} |")
+    errors, reference = preset_errors()
+    lines += ["", f"Preset first-apex error (drop from 1 m; reference apex {reference:.5f} m):", ""]
+    lines += [
+        "| preset | nodes | first apex (m) | relative error | wall for 0.9 s (ms) |",
+        "|---|---:|---:|---:|---:|",
+    ]
+    for preset, (apex, err, wall) in errors.items():
+        nodes = FIDELITY_PRESETS[preset]["n_nodes"]
+        lines.append(f"| {preset} | {nodes} | {apex:.5f} | {err:.2%} | {wall * 1e3:.1f} |")
+    text = "\n".join(lines) + "\n"
+    (RESULTS / "env_throughput.md").write_text(text)
+    print(text)
+    plot(single, vector)
+
+
+def plot(single, vector):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, (left, right) = plt.subplots(1, 2, figsize=(10, 4))
+    x = np.arange(len(PRESETS))
+    for k, mode in enumerate(MODES):
+        left.bar(
+            x + 0.2 * (2 * k - 1), [single[p, mode][0] for p in PRESETS], 0.4, label=f"{mode} (scripted)"
+        )
+    left.set_xticks(x, PRESETS)
+    left.set_ylabel("env steps / s (single process)")
+    left.set_yscale("log")
+    left.legend()
+    for mode in MODES:
+        right.plot(VECTOR_SIZES, [vector[mode, n][0] for n in VECTOR_SIZES], "o-", label=f"native, {mode}")
+        right.plot(
+            VECTOR_SIZES, [vector[mode, n][1] for n in VECTOR_SIZES], "s--", label=f"SyncVectorEnv, {mode}"
+        )
+    right.set_xscale("log")
+    right.set_xlabel("envs")
+    right.set_ylabel("env steps / s (random actions)")
+    right.legend()
+    fig.tight_layout()
+    fig.savefig(RESULTS / "env_throughput.png", dpi=120)
+
+
+if __name__ == "__main__":
+    main()
