@@ -20,6 +20,7 @@ from numba import njit
 from ..physics.actuation import apply_impulse, rest_circle_radius, restart, set_rest_pressure
 from ..physics.contact import FREE
 from ..physics.events import EVENT_APEX, EVENT_LIFTOFF, EVENT_TOUCHDOWN
+from ..physics.loads import centre_of_mass
 from ..physics.model import (
     Model,
     Recording,
@@ -181,12 +182,8 @@ def _rise(me, se, task, e):
     """Height (m) the ball's centre could still rise: free energy (kinetic, elastic and gas above the
     inflated circle at rest) over ``m g``, plus the centre's height above its resting height."""
     x = se.x[0]
-    n = x.shape[0]
-    cy = 0.0
-    for i in range(n):
-        cy += x[i, 1]
-    cy /= n
-    weight = n * me.node_mass[0] * task.gravity
+    cy = centre_of_mass(x, se.v[0])[1]
+    weight = x.shape[0] * me.node_mass[0] * task.gravity
     return se.energy[0, 1] / weight + cy - task.ground_height - task.rest_radius[e]
 
 
@@ -333,19 +330,7 @@ def observe_env(model, state, task, e, row):
     nx, ny = model.grounds[0, 0], model.grounds[0, 1]
     x = state.x[e]
     v = state.v[e]
-    cx = 0.0
-    cy = 0.0
-    ux = 0.0
-    uy = 0.0
-    for i in range(n):
-        cx += x[i, 0]
-        cy += x[i, 1]
-        ux += v[i, 0]
-        uy += v[i, 1]
-    cx /= n
-    cy /= n
-    ux /= n
-    uy /= n
+    cx, cy, ux, uy = centre_of_mass(x, v)
     for i in range(n):
         row[2 * i] = x[i, 0] - cx
         row[2 * i + 1] = x[i, 1] - cy

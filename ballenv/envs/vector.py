@@ -13,7 +13,7 @@ from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from .batch import END_REASONS, REWARD_TERMS, BallBatch, observation_structure
+from .batch import END_FAILURE, END_REASONS, REWARD_TERMS, BallBatch, observation_structure
 from .config import BallEnvConfig, draw_reset, failure_message
 from .inflated_ball import InflatedBallEnv
 
@@ -117,9 +117,10 @@ class InflatedBallVectorEnv(VectorEnv):
     def _step_info(self, stepped):
         task = self._batch.task
         info = {name: np.where(stepped, task.reward[:, k + 1], 0.0) for k, name in enumerate(REWARD_TERMS)}
-        reasons = np.array(
-            [END_REASONS[int(c)] if s else "" for c, s in zip(task.end, stepped, strict=True)], dtype=object
-        )
+        reasons = np.where(stepped, np.array(END_REASONS, dtype=object)[task.end], "")
+        failures = np.full(self.num_envs, "", dtype=object)
+        for i in np.flatnonzero(stepped & (task.end == END_FAILURE)):
+            failures[i] = failure_message(task, i)
         info.update(
             time=task.steps * self.config.control_dt,
             apex_count=np.where(stepped, task.apex_count, 0),
@@ -129,9 +130,7 @@ class InflatedBallVectorEnv(VectorEnv):
             paddle_impulse=np.where(stepped, task.impulse, 0.0),
             termination=reasons,
             sim_failure=reasons == "sim_failure",
-            sim_failure_reason=np.array(
-                [failure_message(task, i) if s else "" for i, s in enumerate(stepped)], dtype=object
-            ),
+            sim_failure_reason=failures,
         )
         return info
 

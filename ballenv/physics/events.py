@@ -16,6 +16,7 @@ import numpy as np
 from numba import njit
 
 from .contact import FREE, deepest_ground
+from .loads import centre_of_mass
 
 EVENT_TOUCHDOWN = 0
 EVENT_LIFTOFF = 1
@@ -24,14 +25,10 @@ EVENT_KINDS = ("touchdown", "liftoff", "apex")
 
 
 @njit(cache=True)
-def _centre(x, v):
-    n = x.shape[0]
-    cy = 0.0
-    vy = 0.0
-    for i in range(n):
-        cy += x[i, 1]
-        vy += v[i, 1]
-    return cy / n, vy / n
+def _height(x, v):
+    """Centre-of-mass height (m) and vertical velocity (m/s)."""
+    _, cy, _, vy = centre_of_mass(x, v)
+    return cy, vy
 
 
 @njit(cache=True)
@@ -49,8 +46,8 @@ def detect_events(model, state, trial, t, h, events, n_events):
     n_nodes = state.x.shape[1]
     contact = model.grounds.shape[0] > 0
     for r in range(n_rings):
-        y0, vy0 = _centre(state.x[r], state.v[r])
-        y1, vy1 = _centre(trial.x[r], trial.v[r])
+        y0, vy0 = _height(state.x[r], state.v[r])
+        y1, vy1 = _height(trial.x[r], trial.v[r])
         if contact:
             before = 0
             after = 0

@@ -110,11 +110,8 @@ def gravity_energy(x, node_mass, gravity):
 
 # ------------------------------------------------------------------------------------------ damping
 @njit(cache=True)
-def rigid_motion(x, v):
-    """Centre of mass (m), its velocity (m/s), spin ``omega`` (rad/s) and ``sum |r|^2`` (m^2).
-
-    For equal node masses: ``omega = sum r_i x u_i / sum |r_i|^2`` with ``r_i = x_i - X``.
-    """
+def centre_of_mass(x, v):
+    """Centre of mass (m) and its velocity (m/s) of nodes of equal mass: ``(cx, cy, vx, vy)``."""
     n = x.shape[0]
     cx = cy = vx = vy = 0.0
     for i in range(n):
@@ -122,10 +119,17 @@ def rigid_motion(x, v):
         cy += x[i, 1]
         vx += v[i, 0]
         vy += v[i, 1]
-    cx /= n
-    cy /= n
-    vx /= n
-    vy /= n
+    return cx / n, cy / n, vx / n, vy / n
+
+
+@njit(cache=True)
+def rigid_motion(x, v):
+    """Centre of mass (m), its velocity (m/s), spin ``omega`` (rad/s) and ``sum |r|^2`` (m^2).
+
+    For equal node masses: ``omega = sum r_i x u_i / sum |r_i|^2`` with ``r_i = x_i - X``.
+    """
+    n = x.shape[0]
+    cx, cy, vx, vy = centre_of_mass(x, v)
     ang = 0.0
     inertia = 0.0
     for i in range(n):

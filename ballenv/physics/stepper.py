@@ -284,25 +284,22 @@ def newton_ring(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active):
                 res[2 * i + d] = val
                 finite = finite and math.isfinite(val)
                 scale = max(scale, abs(inertia) + abs(f[i, d]))
-        if not finite:
-            if lam <= MIN_NEWTON_FRACTION or merit_before == math.inf:
-                return -1
-            lam *= 0.5
-            for i in range(n):
-                for d in range(2):
-                    dx[i, d] += lam * delta[i, d]
-            continue
-        if contact:
-            constrain_residual(
-                model.grounds, active, x1, ws.ve, res, m, c_mass, model.friction_regularization,
-                ws.reaction, ws.friction,
-            )  # fmt: skip
-        merit = 0.0
-        for k in range(2 * n):
-            worst = max(worst, abs(res[k]))
-            merit += res[k] * res[k]
-        if not settled and merit > (1.0 - 2e-4 * lam) * merit_before and lam > MIN_NEWTON_FRACTION:
-            lam *= 0.5
+        merit = math.inf  # |r|^2
+        if finite:
+            if contact:
+                constrain_residual(
+                    model.grounds, active, x1, ws.ve, res, m, c_mass, model.friction_regularization,
+                    ws.reaction, ws.friction,
+                )  # fmt: skip
+            merit = 0.0
+            for k in range(2 * n):
+                worst = max(worst, abs(res[k]))
+                merit += res[k] * res[k]
+        elif lam <= MIN_NEWTON_FRACTION or merit_before == math.inf:
+            return -1
+        worse = merit > (1.0 - 2e-4 * lam) * merit_before
+        if (not finite or not settled) and worse and lam > MIN_NEWTON_FRACTION:
+            lam *= 0.5  # backtrack: take back half of what is left of the last correction
             for i in range(n):
                 for d in range(2):
                     dx[i, d] += lam * delta[i, d]
