@@ -100,7 +100,8 @@ def env_model(model, e):
         model.width[s], model.radius[s], model.pressurised[s], model.gas_constant[s],
         model.gas_exponent, model.atmospheric_pressure, model.gravity, model.use_gravity,
         model.damping, model.damping_mode, model.grounds, model.contact_method,
-        model.friction_regularization, model.impulse_tol, model.rest_energy[s],
+        model.friction_regularization, model.impulse_tol, model.rest_energy[s], model.thickness[s],
+        False, model.reject_self_intersection,
     )  # fmt: skip
 
 
@@ -447,7 +448,7 @@ class BallBatch:
 
 PER_RING_FIELDS = (
     "node_mass", "ea", "ei", "rest_len", "rest_turn", "width", "radius", "pressurised", "gas_constant",
-    "rest_energy",
+    "rest_energy", "thickness",
 )  # fmt: skip
 
 

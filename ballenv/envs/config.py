@@ -18,7 +18,8 @@ MAX_SPEED = 100.0  # m/s, bound of the velocity observations
 MAX_NODE_FORCE = 1e5  # N, bound of the per-node ground normal force observation
 MAX_PRESSURE = 1e7  # Pa, bound of the pressure observation
 FAILURES = {
-    STATUS_STEP_TOO_SMALL: "Newton's iteration failed down to the smallest step Scene.dt_min",
+    STATUS_STEP_TOO_SMALL: "rejected steps (Newton failure, energy gain or a self-crossing wall) "
+    "halved the step below Scene.dt_min",
     STATUS_IMPULSE_AT_DT_MIN: "the contact impulse stayed above impulse_tol at the smallest step",
 }
 

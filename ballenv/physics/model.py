@@ -11,6 +11,7 @@ from typing import NamedTuple
 import numpy as np
 
 from . import ring as ring_geometry
+from .collision import CONTACT_COLUMNS, CONTACTS_PER_NODE
 from .energy import ENERGY_GRAVITY, ENERGY_PARTS, ring_energy
 from .linalg import BAND_COLUMNS, MAX_LOW_RANK, zigzag_positions
 from .loads import DAMPING_CENTRE_OF_MASS, DAMPING_NONE, DAMPING_RIGID
@@ -44,6 +45,9 @@ class Model(NamedTuple):
     friction_regularization: float  # m/s
     impulse_tol: float  # N s
     rest_energy: np.ndarray  # (R,) J: stretching + gas energy of the inflated circle at rest
+    thickness: np.ndarray  # (R,) m: wall thickness (the contact distance of two rings is h_a + h_b)
+    collide: bool  # ring-ring collision (two or more rings and Scene.ring_collision)
+    reject_self_intersection: bool  # reject trial states in which a ring crosses itself
 
 
 class Solver(NamedTuple):
@@ -58,6 +62,21 @@ class Solver(NamedTuple):
     dt_min: float  # s
     adaptive: bool
     growth: float
+
+
+class CollisionWorkspace(NamedTuple):
+    """Scratch of the ring-ring collision code (``collision.py``) for R rings of N nodes."""
+
+    kicked: np.ndarray  # (R, N, 2) m/s: start velocities of the step after the collision impulses
+    kinetic_change: np.ndarray  # (R,) J: change of each ring's kinetic energy by those impulses
+    predicted: np.ndarray  # (R, N, 2) m: x0 + h v0, where the step's contacts are found
+    box: np.ndarray  # (R, 4) m: xmin, ymin, xmax, ymax
+    margin: np.ndarray  # (R,) m: growth of each box in the broad phase
+    order: np.ndarray  # (R,) int64: rings by the left edge of their grown box
+    pairs: np.ndarray  # (R (R - 1) / 2, 2) int64: ring pairs of the broad phase
+    contacts: np.ndarray  # (C, CONTACT_COLUMNS)
+    orientation: np.ndarray  # (R,): +1 counter-clockwise ring, -1 clockwise
+    velocity: np.ndarray  # (R, 3): centre-of-mass velocity (m/s), largest node speed relative to it
 
 
 class Workspace(NamedTuple):
@@ -77,6 +96,7 @@ class Workspace(NamedTuple):
     reaction: np.ndarray  # (N,) normal ground reaction of the last solve (N)
     friction: np.ndarray  # (N,) friction force along the ground's tangent (N)
     energy: np.ndarray  # (5,) energy parts (J)
+    collision: CollisionWorkspace
 
 
 class State(NamedTuple):
@@ -155,6 +175,9 @@ def build_model(scene):
         friction_regularization=float(scene.friction_regularization),
         impulse_tol=float(scene.impulse_tol),
         rest_energy=np.zeros(len(rings)),
+        thickness=np.array([r.thickness for r in rings]),
+        collide=len(rings) > 1 and scene.ring_collision,
+        reject_self_intersection=scene.self_intersection == "reject",
     )
     _fill_rest_energy(model, rings)
     return model
@@ -171,10 +194,11 @@ def _fill_rest_energy(model, rings):
 
 def ground_array(grounds):
     """(G, 4) rows ``(n_x, n_y, d, mu)``: half-plane ``n . x >= d``, ``n = (-sin a, cos a)``,
-    ``d = height cos a`` (the surface passes through (0, height))."""
+    ``d = n . (x_g, height)`` (the surface passes through the ground's point (x, height))."""
     out = np.zeros((len(grounds), 4))
     for k, g in enumerate(grounds):
-        out[k] = (-math.sin(g.angle), math.cos(g.angle), g.height * math.cos(g.angle), g.friction)
+        nx, ny = -math.sin(g.angle), math.cos(g.angle)
+        out[k] = (nx, ny, nx * g.x + ny * g.height, g.friction)
     return out
 
 
@@ -202,8 +226,9 @@ def build_solver(scene):
     )
 
 
-def build_workspace(n_nodes):
-    """Scratch arrays for one ring's Newton solve, allocated once per simulation."""
+def build_workspace(n_nodes, n_rings=1):
+    """Scratch arrays for one ring's Newton solve and the scene's collision detection, allocated
+    once per simulation."""
     n2 = 2 * n_nodes
     return Workspace(
         pos=zigzag_positions(n_nodes),
@@ -222,6 +247,23 @@ def build_workspace(n_nodes):
         reaction=np.zeros(n_nodes),
         friction=np.zeros(n_nodes),
         energy=np.zeros(5),
+        collision=build_collision_workspace(n_rings, n_nodes),
+    )
+
+
+def build_collision_workspace(n_rings, n_nodes):
+    """Scratch of the collision code for ``n_rings`` rings of ``n_nodes`` nodes."""
+    return CollisionWorkspace(
+        kicked=np.zeros((n_rings, n_nodes, 2)),
+        kinetic_change=np.zeros(n_rings),
+        predicted=np.zeros((n_rings, n_nodes, 2)),
+        box=np.zeros((n_rings, 4)),
+        margin=np.zeros(n_rings),
+        order=np.arange(n_rings, dtype=np.int64),
+        pairs=np.zeros((max(1, n_rings * (n_rings - 1) // 2), 2), dtype=np.int64),
+        contacts=np.zeros((n_rings * n_nodes * min(CONTACTS_PER_NODE, max(1, n_rings - 1)), CONTACT_COLUMNS)),
+        orientation=np.ones(n_rings),
+        velocity=np.zeros((n_rings, 3)),
     )
 
 

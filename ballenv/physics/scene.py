@@ -13,6 +13,7 @@ from numbers import Integral, Real
 INTEGRATORS = ("backward_euler", "generalized_alpha")
 DAMPING_MODES = ("rigid", "centre_of_mass")
 CONTACT_METHODS = ("mass_modification", "predictor_corrector")
+SELF_INTERSECTION = ("reject", "ignore")
 
 
 def _fail(owner, name, value, valid):
@@ -146,25 +147,28 @@ class Ring:
 
 @dataclass(frozen=True)
 class Ground:
-    """A ground half-plane: flat (angle 0) or sloped.
+    """A ground half-plane: flat (angle 0), sloped, a wall or a ceiling.
 
     Attributes:
-        angle: slope angle a (rad) in [-pi/2 + 0.01, pi/2 - 0.01]; the inward normal is
-            (-sin a, cos a): positive angles rise to the right.
-        height: y (m) of the surface at x = 0.
+        angle: angle a (rad) of the surface in [-pi, pi]; the normal into the free side is
+            (-sin a, cos a): 0 is a floor, positive angles rise to the right, pi/2 a wall with the
+            free side to its left (a right wall), -pi/2 a left wall, pi a ceiling.
+        height: y (m) of a point of the surface.
         friction: Coulomb coefficient mu in [0, 10] (0: frictionless).
+        x: x (m) of that point (default 0): the surface passes through (x, height).
     """
 
     angle: float = 0.0
     height: float = 0.0
     friction: float = 0.0
+    x: float = 0.0
 
     def __post_init__(self):
         o = "Ground"
         s = object.__setattr__
-        lim = math.pi / 2 - 0.01
-        s(self, "angle", check_real(o, "angle", self.angle, -lim, lim, "rad"))
+        s(self, "angle", check_real(o, "angle", self.angle, -math.pi, math.pi, "rad"))
         s(self, "height", check_real(o, "height", self.height, -1e6, 1e6, "m"))
+        s(self, "x", check_real(o, "x", self.x, -1e6, 1e6, "m"))
         s(self, "friction", check_real(o, "friction", self.friction, 0.0, 10.0))
 
 
@@ -202,6 +206,13 @@ class Scene:
         newton_max_iter: Newton iterations before the step is rejected, in [1, 200].
         atmospheric_pressure: p_atm (Pa) in [0, 1e7]; 0 gives the paper's ``p A = const``.
         gas_exponent: k in ``(p + p_atm) A^k = const`` in [1, 3] (1 isothermal, 1.4 adiabatic air).
+        ring_collision: rings push each other apart when a node comes within the contact distance
+            ``h_a + h_b`` of another ring's centreline (``collision.py``); only with two or more
+            rings. False lets rings pass through each other.
+        self_intersection: "reject" (wall parts of a ring within a few edges of each other along
+            the ring push apart like two rings, and a trial state in which a ring's polygon crosses
+            itself is rejected and the step retried smaller; at ``dt_min`` simulate() stops with
+            SimulationError) or "ignore" (neither).
     """
 
     rings: tuple = field(default_factory=lambda: (Ring(),))
@@ -221,6 +232,8 @@ class Scene:
     newton_max_iter: int = 25
     atmospheric_pressure: float = 101325.0
     gas_exponent: float = 1.0
+    ring_collision: bool = True
+    self_intersection: str = "reject"
 
     def __post_init__(self):
         o = "Scene"
@@ -262,6 +275,9 @@ class Scene:
             check_real(o, "atmospheric_pressure", self.atmospheric_pressure, 0.0, 1e7, "Pa"),
         )
         s(self, "gas_exponent", check_real(o, "gas_exponent", self.gas_exponent, 1.0, 3.0))
+        if not isinstance(self.ring_collision, bool):
+            _fail(o, "ring_collision", self.ring_collision, "True or False")
+        check_choice(o, "self_intersection", self.self_intersection, SELF_INTERSECTION)
 
     @property
     def gravity_vector(self):
@@ -284,4 +300,6 @@ class Scene:
             names.append("ground")
             if any(g.friction > 0.0 for g in self.grounds):
                 names.append("friction")
+        if len(self.rings) > 1 and self.ring_collision:
+            names.append("ring_collision")
         return tuple(names)

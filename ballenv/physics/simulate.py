@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import ring as ring_geometry
+from .collision import find_contacts
 from .energy import ENERGY_PARTS, ring_energy
 from .events import EVENT_APEX, event_list
 from .model import (
@@ -18,12 +19,20 @@ from .model import (
 from .scene import Scene, check_real
 from .stepper import (
     CLOCK_H,
+    COUNT_BY_REASON,
     COUNT_EVENTS,
+    COUNT_IMPULSE_REJECTED,
     COUNT_NEWTON,
     COUNT_RECORDS,
     COUNT_REJECTED,
+    COUNT_REJECTION,
     COUNT_STEPS,
     N_COUNTERS,
+    REJECT_ENERGY,
+    REJECT_INTRUSION,
+    REJECT_NEWTON,
+    REJECT_SELF_INTERSECTION,
+    REJECTION_REASONS,
     STATUS_BUFFER_FULL,
     STATUS_IMPULSE_AT_DT_MIN,
     STATUS_STEP_TOO_SMALL,
@@ -46,7 +55,9 @@ class SimulationError(RuntimeError):
 
 @dataclass(frozen=True)
 class SimulationStats:
-    """Cost of a run: accepted and rejected steps, Newton iterations (linear solves), wall time (s)."""
+    """Cost of a run: accepted and rejected steps, Newton iterations (linear solves), wall time (s);
+    ``rejections`` counts the rejected steps by reason ("newton", "energy", "intrusion",
+    "self_intersection", "impulse": the adaptive step's contact impulse above ``impulse_tol``)."""
 
     steps: int
     rejected_steps: int
@@ -54,6 +65,7 @@ class SimulationStats:
     wall_time: float
     effects: tuple
     integrator: str
+    rejections: dict = field(default_factory=dict)  # rejected steps by reason (see REJECTION_REASONS)
 
 
 @dataclass
@@ -160,13 +172,15 @@ def simulate(scene, t_end, x0=None, v0=None, output_dt=None, progress=False):
     solver = build_solver(scene)
     n_rings = len(scene.rings)
     n_nodes = scene.rings[0].n_nodes
-    ws = build_workspace(n_nodes)
+    ws = build_workspace(n_nodes, n_rings)
     shape = (n_rings, n_nodes, 2)
     x_init, v_init = initial_state(scene)
     state = empty_state(n_rings, n_nodes)
     state.x[:] = _check_state("x0", x0, shape) if x0 is not None else x_init
     state.v[:] = _check_state("v0", v0, shape) if v0 is not None else v_init
     _check_above_grounds(model.grounds, state.x)
+    if model.collide:
+        _check_apart(model, state.x, ws)
     initial_state_values(model, solver, state, ws)
     trial = empty_state(n_rings, n_nodes)
     clock = np.array([0.0, solver.dt])
@@ -200,11 +214,11 @@ def simulate(scene, t_end, x0=None, v0=None, output_dt=None, progress=False):
             )
             break
         if status == STATUS_STEP_TOO_SMALL:
+            reason = REJECTION_REASONS.get(int(counters[COUNT_REJECTION]), "the step was rejected")
             failure = (
                 f"step size fell below Scene.dt_min = {scene.dt_min:g} s at t = {clock[0]:.6g} s "
-                f"(tried {clock[CLOCK_H] * 2:.3g} s): Newton's iteration did not converge. The scene "
-                "may be too stiff or too violent for its settings; lower Scene.dt or raise "
-                "Scene.newton_max_iter."
+                f"(tried {clock[CLOCK_H] * 2:.3g} s): {reason}. The scene may be too stiff or too "
+                "violent for its settings; lower Scene.dt or raise Scene.newton_max_iter."
             )
             break
     if bar is not None:
@@ -216,6 +230,13 @@ def simulate(scene, t_end, x0=None, v0=None, output_dt=None, progress=False):
         wall_time=time.perf_counter() - start,
         effects=scene.effects,
         integrator=scene.integrator,
+        rejections={
+            "newton": int(counters[COUNT_BY_REASON + REJECT_NEWTON - 1]),
+            "energy": int(counters[COUNT_BY_REASON + REJECT_ENERGY - 1]),
+            "intrusion": int(counters[COUNT_BY_REASON + REJECT_INTRUSION - 1]),
+            "self_intersection": int(counters[COUNT_BY_REASON + REJECT_SELF_INTERSECTION - 1]),
+            "impulse": int(counters[COUNT_IMPULSE_REJECTED]),
+        },
     )
     n_out = int(counters[COUNT_RECORDS])
     n_ev = int(counters[COUNT_EVENTS])
@@ -257,6 +278,18 @@ def _check_above_grounds(grounds, x):
                 f"simulate: node {node} of ring {ring} starts {-phi[ring, node]:.3g} m below "
                 f"Scene.grounds[{g}]: every node must start on or above every ground"
             )
+
+
+def _check_apart(model, x, ws):
+    count = find_contacts(x, model.thickness, ws.collision)
+    inside = ws.collision.contacts[:count]
+    inside = inside[inside[:, 5] < 0.0]
+    if len(inside):
+        a, i, b = (int(v) for v in inside[0, :3])
+        raise ValueError(
+            f"simulate: node {i} of ring {a} starts inside ring {b}: rings must start apart "
+            "(Scene.rings positions and radii, or x0)"
+        )
 
 
 def _progress_bar(t_end):

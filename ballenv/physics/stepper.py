@@ -29,6 +29,7 @@ import math
 
 from numba import njit
 
+from .collision import collision_impulses, collision_step_limit, rings_intrude, self_intersects
 from .contact import FREE, constrain_jacobian, constrain_residual, deepest_ground
 from .elastic import bend_force, bend_jacobian, stretch_force, stretch_jacobian
 from .energy import ENERGY_GRAVITY, ring_energy
@@ -59,7 +60,22 @@ COUNT_NEWTON = 2
 COUNT_GRID = 3
 COUNT_RECORDS = 4
 COUNT_EVENTS = 5
-N_COUNTERS = 6
+COUNT_REJECTION = 6  # why the last step was rejected: one of the REJECT_ codes
+COUNT_BY_REASON = 7  # counters[COUNT_BY_REASON + code - 1]: rejected steps by REJECT_ code
+COUNT_IMPULSE_REJECTED = 11  # adaptive steps rejected for a contact impulse above impulse_tol
+N_COUNTERS = 12
+
+# why a trial step was rejected (try_step returns minus the code)
+REJECT_NEWTON = 1  # Newton's iteration failed (non-finite, singular, too many corrections)
+REJECT_ENERGY = 2  # the step gained energy
+REJECT_INTRUSION = 3  # a node of one ring ended inside another ring
+REJECT_SELF_INTERSECTION = 4  # a ring's polygon crossed itself
+REJECTION_REASONS = {
+    REJECT_NEWTON: "Newton's iteration did not converge",
+    REJECT_ENERGY: "the step gained energy",
+    REJECT_INTRUSION: "a node of one ring ended inside another ring",
+    REJECT_SELF_INTERSECTION: "a ring's wall crossed itself",
+}
 
 PENETRATION_TOLERANCE = -1e-12  # m: a free node deeper than this below a ground gets constrained
 MAX_CONTACT_SET_CHANGES = 64
@@ -104,16 +120,17 @@ def free_energy(model, r, x, v, parts, out):
 
 
 @njit(cache=True)
-def _energy_grew(before, after):
-    """True if a step from energies ``before`` to ``after`` (each (total, free) in J, see
-    :func:`free_energy`) raised the total by more than ``ENERGY_GROWTH_TOL`` times the mean free
-    energy. Nothing in a scene without actuation adds energy: the gas and gravity are potentials;
-    damping, friction and the ground's constraints only remove it. Far too large implicit steps of a
-    nonlinear ring can converge to such spurious solutions; they are rejected and retried smaller."""
-    if not math.isfinite(after[0]):
+def _energy_grew(total_before, free_before, total_after, free_after):
+    """True if a step from energy ``total_before`` to ``total_after`` (J; ``free_``: their free
+    parts, see :func:`free_energy`) raised the total by more than ``ENERGY_GROWTH_TOL`` times the
+    mean free energy. Nothing in a scene without actuation adds energy: the gas and gravity are
+    potentials; damping, friction and the ground's constraints only remove it. Far too large
+    implicit steps of a nonlinear ring can converge to such spurious solutions; they are rejected
+    and retried smaller."""
+    if not math.isfinite(total_after):
         return True
-    free = max(0.5 * (before[1] + after[1]), 0.0)
-    return after[0] - before[0] > ENERGY_GROWTH_TOL * free + 1e-12 * abs(before[0])
+    free = max(0.5 * (free_before + free_after), 0.0)
+    return total_after - total_before > ENERGY_GROWTH_TOL * free + 1e-12 * abs(total_before)
 
 
 @njit(cache=True)
@@ -226,6 +243,18 @@ def _rest_on_grounds(grounds, active, v1, a1):
 
 
 @njit(cache=True)
+def mass_coefficients(solver, h):
+    """``(c_M, c_x, c_v, alpha_m)`` of a step ``h`` (s): the Jacobian is ``c_M M - c_x dF/dx - c_v
+    dF/dv``; a constant extra force ``F`` moves a free node of mass ``m`` by ``F / (c_M m)``."""
+    if solver.method == METHOD_BACKWARD_EULER:
+        return 1.0 / (h * h), 1.0, 1.0 / h, 0.0
+    c_x = 1.0 - solver.alpha_f
+    c_mass = (1.0 - solver.alpha_m) / (solver.beta * h * h)
+    c_v = c_x * solver.gamma / (solver.beta * h)
+    return c_mass, c_x, c_v, solver.alpha_m
+
+
+@njit(cache=True)
 def newton_ring(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active):
     """Solve one implicit step of ring ``r``; ``x1, v1, a1`` receive the new state.
 
@@ -244,16 +273,7 @@ def newton_ring(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active):
     """
     n = x0.shape[0]
     m = model.node_mass[r]
-    if solver.method == METHOD_BACKWARD_EULER:
-        c_mass = 1.0 / (h * h)
-        c_x = 1.0
-        c_v = 1.0 / h
-        am = 0.0
-    else:
-        c_mass = (1.0 - solver.alpha_m) / (solver.beta * h * h)
-        c_x = 1.0 - solver.alpha_f
-        c_v = (1.0 - solver.alpha_f) * solver.gamma / (solver.beta * h)
-        am = solver.alpha_m
+    c_mass, c_x, c_v, am = mass_coefficients(solver, h)
     contact = model.contact_method != CONTACT_NONE
     inner_updates = model.contact_method == CONTACT_MASS_MODIFICATION
     set_changes = 0
@@ -378,8 +398,12 @@ def initial_acceleration(model, x, v, a, ws):
 def try_step(model, solver, state, trial, h, ws):
     """One step of every ring from ``state`` into ``trial``.
 
-    Returns (Newton corrections, contact impulse in N s), or (-1, 0) if any ring fails (the step is
-    then rejected). The contact impulse is the largest over rings of
+    Returns (Newton corrections, contact impulse in N s), or (-code, 0) if the step must be rejected,
+    with ``code`` one of the ``REJECT_`` reasons: a ring's Newton iteration failed, a ring gained
+    energy, a ring crossed itself (``model.reject_self_intersection``), or a node of one ring ended
+    inside another (``model.collide``).
+
+    The contact impulse is the largest over rings of
     ``|h sum_i f_i + kappa sum_(i arriving) m min(0, v_n,i + gap_i / h) n|``: the ring's total ground
     reaction impulse over the step (its momentum change by contact, the paper's ``f dt``) less the
     reaction that stops the nodes arriving on a ground in this step (normal velocity ``v_n < 0`` and
@@ -389,21 +413,40 @@ def try_step(model, solver, state, trial, h, ws):
     the integrator's reaction to an arrival per unit momentum: 1 for backward Euler,
     ``(1 - alpha_m) / beta`` for generalized-alpha (whose Newmark update reflects the node's normal
     velocity before :func:`_rest_on_grounds` removes it).
+
+    With ring collision, the collision impulses are found on the predicted positions ``x0 + h v0``
+    and added to the start velocities (``collision.py``); each ring's energy guard is credited with
+    the change of its kinetic energy by them. They are not part of the contact impulse (the part
+    that stops an approaching node does not shrink with the step).
     """
     total = 0
     impulse = 0.0
     contact = model.contact_method != CONTACT_NONE
+    cw = ws.collision
+    v0 = state.v
+    kicks = model.collide or model.reject_self_intersection
+    if kicks:
+        v0 = cw.kicked
+        collision_impulses(
+            state.x, state.v, h, model.thickness, model.node_mass, model.collide,
+            model.reject_self_intersection, cw, v0, cw.kinetic_change,
+        )  # fmt: skip
     for r in range(state.x.shape[0]):
         trial.active[r] = state.active[r]
         its = newton_ring(
-            model, solver, r, state.x[r], state.v[r], state.a[r], h, trial.x[r], trial.v[r],
+            model, solver, r, state.x[r], v0[r], state.a[r], h, trial.x[r], trial.v[r],
             trial.a[r], ws, trial.active[r],
         )  # fmt: skip
         if its < 0:
-            return -1, 0.0
+            return -REJECT_NEWTON, 0.0
+        if model.reject_self_intersection and self_intersects(trial.x[r]):
+            return -REJECT_SELF_INTERSECTION, 0.0
         free_energy(model, r, trial.x[r], trial.v[r], ws.energy, trial.energy[r])
-        if _energy_grew(state.energy[r], trial.energy[r]):
-            return -1, 0.0
+        kick = cw.kinetic_change[r] if kicks else 0.0
+        if _energy_grew(
+            state.energy[r, 0] + kick, state.energy[r, 1] + kick, trial.energy[r, 0], trial.energy[r, 1]
+        ):
+            return -REJECT_ENERGY, 0.0
         total += its
         if contact:
             m = model.node_mass[r]
@@ -428,10 +471,12 @@ def try_step(model, solver, state, trial, h, ws):
                 if state.active[r, i] == FREE:
                     # the reaction that stops the node on the surface: kappa m (v_n + gap / h)
                     gap = max(0.0, nx * state.x[r, i, 0] + ny * state.x[r, i, 1] - model.grounds[g, 2])
-                    vn = min(0.0, state.v[r, i, 0] * nx + state.v[r, i, 1] * ny + gap / h)
+                    vn = min(0.0, v0[r, i, 0] * nx + v0[r, i, 1] * ny + gap / h)
                     jx += m * vn * nx
                     jy += m * vn * ny
             impulse = max(impulse, math.sqrt(jx * jx + jy * jy))
+    if model.collide and rings_intrude(trial.x, model.thickness, cw):
+        return -REJECT_INTRUSION, 0.0
     return total, impulse
 
 
@@ -463,11 +508,14 @@ def advance(model, solver, ws, state, trial, clock, counters, t_pause, t_end, ou
     Records into ``rec`` from index ``counters[COUNT_RECORDS]`` on: every accepted step if
     ``output_dt == 0``, else exactly at multiples of ``output_dt`` (steps are shortened to land on
     them); events go to ``rec.events`` rows (t, ring, kind, centre-of-mass height). Returns
-    STATUS_DONE, STATUS_BUFFER_FULL (call again with room), STATUS_STEP_TOO_SMALL (Newton failures
-    halved the step below ``dt_min``) or STATUS_IMPULSE_AT_DT_MIN (the contact impulse exceeds
-    ``impulse_tol`` even at ``dt_min``); on failure the state is the last accepted one.
+    STATUS_DONE, STATUS_BUFFER_FULL (call again with room), STATUS_STEP_TOO_SMALL (rejected steps
+    halved the step below ``dt_min``; ``counters[COUNT_REJECTION]`` says why the last one was) or
+    STATUS_IMPULSE_AT_DT_MIN (the contact impulse exceeds ``impulse_tol`` even at ``dt_min``); on
+    failure the state is the last accepted one.
 
-    Step control: a step whose Newton iteration fails is retried with half the step. Adaptive: with
+    Step control: a rejected step (see :func:`try_step`) is retried with half the step. With ring
+    collision, every step is first kept within :func:`collision.collision_step_limit` (no node can
+    cross more than half the contact distance toward another ring in it). Adaptive: with
     ground contact, a step whose contact impulse (see :func:`try_step`) exceeds ``impulse_tol`` is
     retried with ``h * max(0.2, 0.9 tol / (f h))``; accepted steps grow by ``min(growth, 1 + (ratio -
     1) / 2)`` (cautious), up to ``dt``.
@@ -477,6 +525,9 @@ def advance(model, solver, ws, state, trial, clock, counters, t_pause, t_end, ou
     while clock[CLOCK_T] < t_pause:
         if counters[COUNT_RECORDS] >= capacity or counters[COUNT_EVENTS] + 3 * n_rings > rec.events.shape[0]:
             return STATUS_BUFFER_FULL
+        if model.collide:
+            limit = collision_step_limit(state.x, state.v, model.thickness, clock[CLOCK_H], ws.collision)
+            clock[CLOCK_H] = max(min(clock[CLOCK_H], limit), solver.dt_min)
         t = clock[CLOCK_T]
         eps = 1e-9 * solver.dt
         stop = t + clock[CLOCK_H]
@@ -496,6 +547,8 @@ def advance(model, solver, ws, state, trial, clock, counters, t_pause, t_end, ou
         h = stop - t
         its, impulse = try_step(model, solver, state, trial, h, ws)
         if its < 0:
+            counters[COUNT_REJECTION] = -its
+            counters[COUNT_BY_REASON - its - 1] += 1
             counters[COUNT_REJECTED] += 1
             clock[CLOCK_H] = 0.5 * h
             if clock[CLOCK_H] < solver.dt_min:
@@ -507,6 +560,7 @@ def advance(model, solver, ws, state, trial, clock, counters, t_pause, t_end, ou
             if h <= 1.001 * solver.dt_min:  # (h = stop - t carries round-off)
                 return STATUS_IMPULSE_AT_DT_MIN
             counters[COUNT_REJECTED] += 1
+            counters[COUNT_IMPULSE_REJECTED] += 1
             clock[CLOCK_H] = max(solver.dt_min, h * max(0.2, 0.9 * ratio))
             continue
         counters[COUNT_STEPS] += 1

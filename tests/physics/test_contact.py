@@ -171,7 +171,7 @@ def test_a_ball_starting_below_a_ground_is_rejected():
 @pytest.mark.parametrize(
     ("kwargs", "field"),
     [
-        ({"angle": 2.0}, "angle"),
+        ({"angle": 4.0}, "angle"),
         ({"angle": math.nan}, "angle"),
         ({"height": math.inf}, "height"),
         ({"friction": -0.1}, "friction"),

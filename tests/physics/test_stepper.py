@@ -56,10 +56,10 @@ def test_energy_guard_flags_a_step_that_adds_energy():
     free_energy(model, 0, x[0], moving, parts, kicked)
     free_energy(model, 0, x[0], np.full_like(moving, np.nan), parts, broken)
     assert at_rest[1] == pytest.approx(0.0, abs=1e-12 * at_rest[0])  # the inflated circle is the rest state
-    assert not _energy_grew(at_rest, at_rest)
-    assert _energy_grew(at_rest, kicked)
-    assert not _energy_grew(kicked, at_rest)
-    assert _energy_grew(at_rest, broken)
+    assert not _energy_grew(*at_rest, *at_rest)
+    assert _energy_grew(*at_rest, *kicked)
+    assert not _energy_grew(*kicked, *at_rest)
+    assert _energy_grew(*at_rest, *broken)
 
 
 def test_friction_on_arriving_nodes_does_not_stall_newton():
