@@ -29,6 +29,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/step_cost.py
 	$(PY) benchmarks/linear_solve.py
 	$(PY) benchmarks/contact_cost.py
+	$(PY) benchmarks/work_precision.py
 	$(PY) benchmarks/env_throughput.py
 
 lint: $(STAMP)
