@@ -345,6 +345,36 @@ def restitution(pressure, numerics, t_end=0.5):
     return observe(traj, t_end)["cor"]
 
 
+# ------------------------------------------------------------- damping of the wall's vibration in flight
+DECAY_DTS = [1e-2, 5e-3, 2e-3, 5e-4, 1e-4]
+
+
+def vibration_decay(dt_max, impulse_tol=1e-3, window=(0.55, 1.05), t_end=1.5):
+    """Damped 3 s scene (c = 20 1/s), GA adaptive with largest step ``dt_max``: the decay rate (1/s) of
+    the wall's vibration energy in the first flight, ``ln(E(t0) / E(t1)) / (t1 - t0)`` over ``window``,
+    and the second apex (m). Vibration energy: kinetic + elastic + gas energy minus the rest state's
+    and the centre of mass's kinetic energy (it does not oscillate within a period, so sparse records
+    do not alias it). A lightly damped mode of ``u'' + c u' + w^2 u = 0`` loses energy at the rate c."""
+    scene = configured(base_scene("bouncing"), n_nodes=64, adaptive=True, dt=dt_max, impulse_tol=impulse_tol)
+    traj = simulate(scene, t_end)
+    e = traj.energy()
+    internal = e["kinetic"][:, 0] + e["stretching"][:, 0] + e["bending"][:, 0] + e["gas"][:, 0]
+    v_cm = traj.v[:, 0].mean(axis=1)
+    mass = _ring_mass(scene)
+    internal = internal - internal[0] - 0.5 * mass * np.sum(v_cm**2, axis=1)
+    k0, k1 = (np.searchsorted(traj.t, t) for t in window)
+    rate = math.log(internal[k0] / internal[k1]) / (traj.t[k1] - traj.t[k0])
+    apexes = traj.apexes()
+    return rate, float(apexes[1, 1]) if len(apexes) > 1 else math.nan
+
+
+def _ring_mass(scene):
+    from ballenv.physics.ring import node_mass
+
+    ring = scene.rings[0]
+    return node_mass(ring) * ring.n_nodes
+
+
 # ---------------------------------------------------------------------------------------------- main
 REFERENCE_CHECKS = {  # label -> override of the reference settings
     "impulse_tol and dt halved": dict(impulse_tol=REFERENCE["impulse_tol"] / 2, dt=REFERENCE["dt"] / 2),
@@ -409,7 +439,7 @@ def main(argv=None):
     RESULTS.mkdir(exist_ok=True)
     names = ["bounce"] if args.quick else list(SCENES)
     n_runs = sum(sum(len(v) for v in curves(n, args.quick).values()) + len(FIDELITY_PRESETS) for n in names)
-    n_runs += 3 * len(names) + (0 if args.quick else len(PRESSURES) * len(COR_SETTINGS) + 2)
+    n_runs += 3 * len(names) + (0 if args.quick else len(PRESSURES) * len(COR_SETTINGS) + len(DECAY_DTS) + 1)
     start = time.perf_counter()
     with tqdm(total=n_runs, desc="work-precision") as bar:
         refs = references(bar) if not args.quick else {"bounce": (reference("bounce"), {}, {})}
@@ -420,15 +450,18 @@ def main(argv=None):
             errs = flight_errors(integrator, dts)
             orders[integrator] = (dts, errs, fitted_order(dts, errs))
         bar.update()
-        cor = {}
+        cor, decay = {}, {}
         if not args.quick:
+            for dt in DECAY_DTS:
+                decay[dt] = vibration_decay(dt)
+                bar.update()
             for label, numerics in COR_SETTINGS.items():
                 cor[label] = []
                 for p in PRESSURES:
                     cor[label].append(restitution(p, numerics))
                     bar.update()
     elapsed = time.perf_counter() - start
-    text = report(refs, runs, orders, cor, elapsed, args.quick)
+    text = report(refs, runs, orders, cor, decay, elapsed, args.quick)
     suffix = "_quick" if args.quick else ""
     (RESULTS / f"work_precision{suffix}.md").write_text(text)
     print(text)
@@ -436,7 +469,7 @@ def main(argv=None):
     plot_extras(runs["bounce"], refs["bounce"], orders, cor, RESULTS / f"work_precision_pareto{suffix}.png")
 
 
-def report(refs, runs, orders, cor, elapsed, quick):
+def report(refs, runs, orders, cor, decay, elapsed, quick):
     lines = [
         "# Work-precision",
         "",
@@ -572,6 +605,19 @@ def report(refs, runs, orders, cor, elapsed, quick):
         ]
         for label, values in cor.items():
             lines.append(f"| {label} | " + " | ".join(_fmt(v, ".3f") for v in values) + " |")
+    if decay:
+        lines += [
+            "",
+            "## Damping of the wall's vibration in flight vs the largest step",
+            "",
+            "3 s scene (damping c = 20 1/s), GA adaptive, impulse_tol = 1e-3 N s, N = 64: decay rate of the "
+            "vibration energy in the first flight (physical: about c = 20 1/s) and the second apex:",
+            "",
+            "| largest dt (s) | " + " | ".join(f"{dt:g}" for dt in decay) + " |",
+            "|---|" + "---:|" * len(decay),
+            "| decay rate (1/s) | " + " | ".join(f"{r:.1f}" for r, _ in decay.values()) + " |",
+            "| second apex (m) | " + " | ".join(f"{a:.4f}" for _, a in decay.values()) + " |",
+        ]
     return "\n".join(lines) + "\n"
 
 
@@ -633,6 +679,13 @@ def plot_sweeps(refs, runs, path):
             ax.tick_params(labelsize=7)
             ax.grid(True, which="major", lw=0.3)
     axes[0, 0].legend(fontsize=6, ncol=1)
+    for row in axes[1:]:  # curves of this row that the first row's legend does not list
+        first = set(axes[0, 0].get_legend_handles_labels()[1])
+        handles = [
+            (h, lab) for h, lab in zip(*row[0].get_legend_handles_labels(), strict=True) if lab not in first
+        ]
+        if handles:
+            row[0].legend(*zip(*handles, strict=True), fontsize=6)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
