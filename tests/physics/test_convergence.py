@@ -68,3 +68,26 @@ def test_reduced_single_bounce_sweep(bounce_reference):
     runs = {"GA MM adaptive": list(ga.items()), "BE MM fixed": list(be.items())}
     front = wp.pareto(runs)
     assert [curve for curve, _, _ in front] == ["GA MM adaptive"] * len(front)
+
+
+def test_backward_euler_damping_inverts_the_restitution_trend_that_converged_runs_show():
+    # the physics view of the benchmark: restitution rises with inflation pressure; BE at a 1 ms step
+    # damps the stiffer ball's ringing more and shows the opposite trend, a fine BE step recovers it
+    low, high = 10e3, 60e3
+    converged = wp.COR_SETTINGS["GA adaptive tol=1e-4 (converged)"]
+    coarse_be = wp.COR_SETTINGS["BE dt=0.001"]
+    fine_be = wp.COR_SETTINGS["BE dt=6.25e-05"]
+    assert wp.restitution(high, converged) > wp.restitution(low, converged) + 0.05
+    assert wp.restitution(high, coarse_be) < wp.restitution(low, coarse_be) - 0.05
+    assert wp.restitution(high, fine_be) > wp.restitution(low, fine_be) + 0.03
+
+
+def test_single_bounce_reference_converges_in_the_step_and_to_about_a_tenth_of_a_percent_in_n(
+    bounce_reference,
+):
+    # the README's statement of the reference's own convergence (halved step control; doubled N)
+    ref = bounce_reference.obs
+    refined = wp.errors(wp.reference("bounce", impulse_tol=5e-5, dt=5e-4).obs, ref)
+    doubled = wp.errors(wp.reference("bounce", n_nodes=512).obs, ref)
+    assert refined["apex"] < 1e-4 and refined["cor"] < 1e-4
+    assert doubled["apex"] < 2e-3 and doubled["cor"] < 1e-3
