@@ -30,6 +30,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/linear_solve.py
 	$(PY) benchmarks/contact_cost.py
 	$(PY) benchmarks/collision_cost.py
+	$(PY) benchmarks/work_precision.py
 	$(PY) benchmarks/env_throughput.py
 
 lint: $(STAMP)

@@ -24,3 +24,42 @@ def test_preset_sets_the_numerics_and_keeps_the_physics(name):
 def test_unknown_preset_is_a_clear_error():
     with pytest.raises(ValueError, match="fidelity"):
         with_fidelity(Scene(), "ultra")
+
+
+# first-apex error bounds on the single-bounce scene of benchmarks/work_precision.py, as the README states
+README_APEX_ERROR_BOUNDS = {"fast": 0.05, "balanced": 0.005, "accurate": 0.003}
+
+
+def _work_precision():
+    import importlib.util
+    import pathlib
+    import sys
+
+    if "work_precision" not in sys.modules:
+        path = pathlib.Path(__file__).resolve().parents[2] / "benchmarks" / "work_precision.py"
+        spec = importlib.util.spec_from_file_location("work_precision", path)
+        module = importlib.util.module_from_spec(spec)
+        sys.modules["work_precision"] = module  # dataclasses look their module up here
+        spec.loader.exec_module(module)
+    return sys.modules["work_precision"]
+
+
+@pytest.fixture(scope="module")
+def single_bounce_errors():
+    wp = _work_precision()
+    reference = wp.reference("bounce")  # N = 256, impulse_tol = 1e-4 N s, dt <= 1e-3 s
+    out = {}
+    for name in FIDELITY_PRESETS:
+        run = wp.run(wp.preset_scene("bounce", name), wp.SCENES["bounce"], repeats=1)
+        out[name] = wp.errors(run.obs, reference.obs)
+    return out
+
+
+@pytest.mark.parametrize("name", sorted(FIDELITY_PRESETS))
+def test_preset_first_apex_error_is_within_the_readme_bound(single_bounce_errors, name):
+    assert single_bounce_errors[name]["apex"] < README_APEX_ERROR_BOUNDS[name]
+
+
+def test_balanced_preset_meets_the_one_percent_target_and_fast_is_coarser(single_bounce_errors):
+    assert single_bounce_errors["balanced"]["apex"] < 0.01
+    assert single_bounce_errors["fast"]["apex"] > 3 * single_bounce_errors["balanced"]["apex"]
