@@ -50,8 +50,10 @@ rejects the topologies 3 b and c. :func:`collision_step_limit` keeps a step shor
 node can cross more than half the contact distance of a nearby ring in it (no tunnelling).
 
 A ring's contact with itself (a fold or a crumple of the wall): each node gets the same impulse
-against the nearest edge of its own ring within ``SELF_CONTACT_WINDOW`` edges along the ring (not
-its own two), at the contact distance ``2 h``, toward the side it is on at the step's start. A
+against the nearest edge of its own ring among the ``SELF_CONTACT_WINDOW`` edges on each side that
+begin ``SELF_CONTACT_ARC`` contact distances of arc length away (nearer wall is the node's own
+neighbourhood: with more nodes than ``pi R / h`` an edge is shorter than ``2 h``, and testing it
+would push neighbours apart), at the contact distance ``2 h``, toward the side it is on at the step's start. A
 self-crossing state is never accepted: :func:`self_intersects` tests every trial state and the
 stepper rejects it (a star-shape test around the centroid proves most states simple in O(N); only
 the others pay the O(N^2) segment test). Wall parts far apart along the ring (a ball squashed
@@ -68,6 +70,7 @@ from .cyclic import next_node, prev_node
 CONTACT_COLUMNS = 6
 CONTACTS_PER_NODE = 6  # other rings a node can touch at once (hexagonal packing)
 SELF_CONTACT_WINDOW = 6  # edges on each side of a node searched for contact with its own wall
+SELF_CONTACT_ARC = 2.0  # own wall nearer than this many contact distances along the ring is skipped
 RELAXATION_TIME = 1e-2  # s: a node found inside the contact distance is pushed out over this time
 
 
@@ -313,35 +316,55 @@ def _kick(v, h, node_mass, a, i, b, j, t, nx, ny, signed, delta, relax, kicked):
 
 
 @njit(cache=True)
+def _nearest_own_edge(pred, r, i, step, arc0, best, best_j, best_t):
+    """Scan ring ``r``'s edges from node ``i`` along the ring in direction ``step`` (+1 or -1):
+    skip the edges whose nearest end lies less than ``arc0`` (m, arc length at the predicted
+    positions ``pred``) from ``i``, then test the next ``SELF_CONTACT_WINDOW``; keep the nearest edge closer
+    than ``sqrt(best)`` at the predicted positions. Returns ``(best, best_j, best_t)``."""
+    n = pred.shape[1]
+    px, py = pred[r, i, 0], pred[r, i, 1]
+    arc = 0.0
+    tested = 0
+    node = i
+    for _ in range(n // 2 - 1):
+        far = (node + step) % n
+        arc += math.hypot(pred[r, far, 0] - pred[r, node, 0], pred[r, far, 1] - pred[r, node, 1])
+        near, node = far, far
+        far = (node + step) % n
+        if arc < arc0:
+            continue
+        j = near if step > 0 else far  # edge (j, j + 1)
+        q = next_node(j, n)
+        ex, ey = pred[r, q, 0] - pred[r, j, 0], pred[r, q, 1] - pred[r, j, 1]
+        length2 = ex * ex + ey * ey
+        t = 0.0
+        if length2 > 0.0:
+            t = min(1.0, max(0.0, ((px - pred[r, j, 0]) * ex + (py - pred[r, j, 1]) * ey) / length2))
+        dx = px - pred[r, j, 0] - t * ex
+        dy = py - pred[r, j, 1] - t * ey
+        if dx * dx + dy * dy < best:
+            best = dx * dx + dy * dy
+            best_j = j
+            best_t = t
+        tested += 1
+        if tested == SELF_CONTACT_WINDOW:
+            break
+    return best, best_j, best_t
+
+
+@njit(cache=True)
 def _self_contacts(x, pred, v, h, r, delta, relax, node_mass, kicked):
-    """Impulses between node ``i`` of ring ``r`` and the nearest edge within
-    ``SELF_CONTACT_WINDOW`` edges of it along the ring (not its own two edges) closer than
-    ``delta`` at the predicted positions; the normal points to the side the node is on at the
-    step's start. Returns the number of contacts."""
+    """Impulses between node ``i`` of ring ``r`` and the nearest edge of its own ring closer than
+    ``delta`` at the predicted positions, among the ``SELF_CONTACT_WINDOW`` edges on each side that
+    begin ``SELF_CONTACT_ARC * delta`` of arc length away from the node (nearer wall cannot touch
+    it without a fold sharper than the wall is thick); the normal points to the side the node is on
+    at the step's start. Returns the number of contacts."""
     n = x.shape[1]
-    reach = min(SELF_CONTACT_WINDOW, (n - 3) // 2)
+    arc0 = SELF_CONTACT_ARC * delta
     count = 0
     for i in range(n):
-        px, py = pred[r, i, 0], pred[r, i, 1]
-        best = delta * delta
-        best_j = -1
-        best_t = 0.0
-        for k in range(-reach - 1, reach + 1):
-            if k == -1 or k == 0:
-                continue
-            j = (i + k) % n
-            q = next_node(j, n)
-            ex, ey = pred[r, q, 0] - pred[r, j, 0], pred[r, q, 1] - pred[r, j, 1]
-            length2 = ex * ex + ey * ey
-            t = 0.0
-            if length2 > 0.0:
-                t = min(1.0, max(0.0, ((px - pred[r, j, 0]) * ex + (py - pred[r, j, 1]) * ey) / length2))
-            dx = px - pred[r, j, 0] - t * ex
-            dy = py - pred[r, j, 1] - t * ey
-            if dx * dx + dy * dy < best:
-                best = dx * dx + dy * dy
-                best_j = j
-                best_t = t
+        best, best_j, best_t = _nearest_own_edge(pred, r, i, 1, arc0, delta * delta, -1, 0.0)
+        best, best_j, best_t = _nearest_own_edge(pred, r, i, -1, arc0, best, best_j, best_t)
         if best_j < 0:
             continue
         j = best_j

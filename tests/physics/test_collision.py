@@ -285,3 +285,22 @@ def test_self_contact_stops_a_fold_and_conserves_momentum():
     assert change[0] == pytest.approx(0.5 * mass[0] * ((kicked**2).sum() - (v**2).sum()), rel=1e-12)
     off = collision_impulses(x, v, 1e-3, thickness, mass, False, False, cw, kicked, change)
     assert off == 0 and np.array_equal(kicked, v)
+
+
+@pytest.mark.parametrize("n_nodes", [256, 512])
+def test_fine_rings_wall_gets_no_self_contact_from_its_own_neighbours(n_nodes):
+    # edges (2.9 mm and 1.5 mm) shorter than the 4 mm contact distance of a 2 mm wall: a round ring
+    # and one flattened on the ground (a straight bottom chord) touch nothing of their own
+    x = polygon((0.0, 0.12), 0.12, n_nodes)
+    flat = x.copy()
+    flat[:, 1] = np.maximum(flat[:, 1], 0.02)
+    cw = build_collision_workspace(1, n_nodes)
+    thickness, mass = np.array([2e-3]), np.array([1e-4])
+    for state in (x, flat):
+        v = np.zeros((1, n_nodes, 2))
+        v[0, :, 1] = -1.0
+        kicked = np.zeros_like(v)
+        count = collision_impulses(
+            state[None], v, 1e-3, thickness, mass, False, True, cw, kicked, np.zeros(1)
+        )
+        assert count == 0 and np.array_equal(kicked, v)
