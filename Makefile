@@ -1,4 +1,4 @@
-# The two commands of the README:  make demo  (the main job)  and  make test  (the test suite).
+# The two commands of the README:  make train  (the main job)  and  make test  (the test suite).
 # Both create .venv and install the package with what they need on first use.
 PYTHON ?= python3
 VENV := .venv
@@ -6,7 +6,7 @@ PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 export OPENBLAS_NUM_THREADS := 1
 
-.PHONY: venv demo test test-slow bench lint format clean
+.PHONY: venv train demo test test-slow bench lint format clean
 
 $(STAMP): pyproject.toml constraints.txt
 	$(PYTHON) -m venv $(VENV)
@@ -15,6 +15,9 @@ $(STAMP): pyproject.toml constraints.txt
 	touch $(STAMP)
 
 venv: $(STAMP)
+
+train: $(STAMP)
+	$(PY) train.py --algo ppo --action-mode pressure --log-dir runs
 
 demo: $(STAMP)
 	$(PY) -m ballenv.demo --out out
@@ -42,5 +45,5 @@ format: $(STAMP)
 	$(PY) -m ruff check --fix .
 
 clean:
-	rm -rf $(VENV) out .pytest_cache .ruff_cache
+	rm -rf $(VENV) out runs .pytest_cache .ruff_cache
 	find . -name __pycache__ -type d -prune -exec rm -rf {} +

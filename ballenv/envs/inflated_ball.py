@@ -10,108 +10,108 @@ from .config import BallEnvConfig, draw_reset, failure_message
 
 class InflatedBallEnv(Env, EzPickle):
     r"""
-            ## Description
-            A 2-D inflated ring (discrete elastic rods: stretching and bending of the wall, gas that follows
-            the isothermal gas law ``(p + p_atm) A = const``) falls and bounces on a flat ground with Coulomb
-            friction, simulated by implicit Newton steps with adaptive step size (see ``ballenv.physics``).
-            Each episode draws a target apex height for the ball's centre of mass; the agent keeps the ball
-            bouncing to it, either by pumping gas in and out (``action_mode="pressure"``) or by striking the
-            ball from above with a paddle, like a hand dribbling (``action_mode="paddle"``). The ball loses
-            energy at every impact (and to the wall's damping, ``damping``), so an uncontrolled ball comes to
-            rest within a few seconds.
+    ## Description
+    A 2-D inflated ring (discrete elastic rods: stretching and bending of the wall, gas that follows
+    the isothermal gas law ``(p + p_atm) A = const``) falls and bounces on a flat ground with Coulomb
+    friction, simulated by implicit Newton steps with adaptive step size (see ``ballenv.physics``).
+    Each episode draws a target apex height for the ball's centre of mass; the agent keeps the ball
+    bouncing to it, either by pumping gas in and out (``action_mode="pressure"``) or by striking the
+    ball from above with a paddle, like a hand dribbling (``action_mode="paddle"``). The ball loses
+    energy at every impact (and to the wall's damping, ``damping``), so an uncontrolled ball comes to
+    rest within a few seconds.
 
-            ## Action Space
-            ``Box(-1, 1, (1,), float32)``; values outside are clipped, NaN raises ``ValueError``.
+    ## Action Space
+    ``Box(-1, 1, (1,), float32)``; values outside are clipped, NaN raises ``ValueError``.
 
-            | Mode     | Action a in [-1, 1] sets                                                     | Unit  |
-            |----------|------------------------------------------------------------------------------|-------|
-            | pressure | the gas amount, as the gauge pressure at rest p = p_lo + (a + 1)/2 (p_hi - p_lo) | Pa |
-            | paddle   | the downward impulse J = (a + 1)/2 * paddle_max_impulse, delivered if in reach | N s |
+    | Mode     | Action a in [-1, 1] sets                                                     | Unit  |
+    |----------|------------------------------------------------------------------------------|-------|
+    | pressure | the gas amount, as the gauge pressure at rest p = p_lo + (a + 1)/2 (p_hi - p_lo) | Pa |
+    | paddle   | the downward impulse J = (a + 1)/2 * paddle_max_impulse, delivered if in reach | N s |
 
-            Pressure: the gas setpoint moves toward the commanded value at most ``pressure_rate`` (a pump's
-            flow; instant jumps of the gas ring the ball's breathing mode like a bell) and is applied at the
-            start of the control step; the gas law then sets the pressure as the ball deforms, so raising it
-            while the ball is squashed does work ``p dA`` as it re-expands.
-            Paddle: the paddle hovers at ``target + r`` (where the ball's top is at the target apex); it
-            strikes only when the ball's top is within ``paddle_reach`` of it, and then shares ``J`` equally
-            among the nodes within ``paddle_depth`` of the top: the ball's momentum changes by exactly J.
+    Pressure: the gas setpoint moves toward the commanded value at most ``pressure_rate`` (a pump's
+    flow; instant jumps of the gas ring the ball's breathing mode like a bell) and is applied at the
+    start of the control step; the gas law then sets the pressure as the ball deforms, so raising it
+    while the ball is squashed does work ``p dA`` as it re-expands.
+    Paddle: the paddle hovers at ``target + r`` (where the ball's top is at the target apex); it
+    strikes only when the ball's top is within ``paddle_reach`` of it, and then shares ``J`` equally
+    among the nodes within ``paddle_depth`` of the top: the ball's momentum changes by exactly J.
 
-            ## Observation Space
-            ``Box(low, high, (5 N + 6,), float32)`` (``+3`` in paddle mode), N nodes (32 for the "fast"
-            preset). Values are clipped to the bounds; ``info["observation_structure"]`` maps names to slices.
+    ## Observation Space
+    ``Box(low, high, (5 N + 6,), float32)`` (``+3`` in paddle mode), N nodes (32 for the "fast"
+    preset). Values are clipped to the bounds; ``info["observation_structure"]`` maps names to slices.
 
-            | Slice (name)             | Observation                                             | Unit | Bounds |
-            |--------------------------|---------------------------------------------------------|------|--------|
-            | node_position (2N)       | node x, y relative to the centre of mass, interleaved   | m    | +-4 r_max |
-            | node_velocity (2N)       | node velocity relative to the centre-of-mass velocity   | m/s  | +-100 |
-            | centre_of_mass_position  | x, and height above the ground                          | m    | arena |
-            | centre_of_mass_velocity  | vx, vy                                                  | m/s  | +-100 |
-            | ground_normal_force (N)  | each node's normal ground reaction (0 in flight)        | N    | [0, 1e5] |
-            | pressure                 | current gauge pressure of the gas                       | Pa   | [-101325, 1e7] |
-            | target_height            | this episode's target apex height of the centre of mass | m    | target range |
-            | paddle_height (paddle)   | the paddle's height                                     | m    | [0, arena + 4 r_max] |
-            | paddle_in_reach (paddle) | 1 if the paddle could strike at the last step, else 0   | -    | [0, 1] |
-            | paddle_impulse (paddle)  | impulse delivered at the last step                      | N s  | [0, J_max] |
+    | Slice (name)             | Observation                                             | Unit | Bounds |
+    |--------------------------|---------------------------------------------------------|------|--------|
+    | node_position (2N)       | node x, y relative to the centre of mass, interleaved   | m    | +-4 r_max |
+    | node_velocity (2N)       | node velocity relative to the centre-of-mass velocity   | m/s  | +-100 |
+    | centre_of_mass_position  | x, and height above the ground                          | m    | arena |
+    | centre_of_mass_velocity  | vx, vy                                                  | m/s  | +-100 |
+    | ground_normal_force (N)  | each node's normal ground reaction (0 in flight)        | N    | [0, 1e5] |
+    | pressure                 | current gauge pressure of the gas                       | Pa   | [-101325, 1e7] |
+    | target_height            | this episode's target apex height of the centre of mass | m    | target range |
+    | paddle_height (paddle)   | the paddle's height                                     | m    | [0, arena + 4 r_max] |
+    | paddle_in_reach (paddle) | 1 if the paddle could strike at the last step, else 0   | -    | [0, 1] |
+    | paddle_impulse (paddle)  | impulse delivered at the last step                      | N s  | [0, J_max] |
 
-            ## Rewards
-            The sum of the terms, each also in ``info``:
-            - ``reward_apex``: at each apex in flight, ``-apex_reward_weight * |h - h_target| / h_target``
-              (h: the centre of mass's apex height, located inside the simulator's step).
-            - ``reward_shaping`` (off by default): ``-shaping_reward_weight * control_dt * |h_reach -
-              h_target| / h_target`` every step, ``h_reach`` the apex the ball's free energy could reach.
-            - ``reward_termination``: on early termination, ``-termination_reward_weight`` per apex left
-              until the time limit (a resting ball misses each by about the whole target), so stopping the
-              ball or breaking the simulator never pays.
+    ## Rewards
+    The sum of the terms, each also in ``info``:
+    - ``reward_apex``: at each apex in flight, ``-apex_reward_weight * |h - h_target| / h_target``
+      (h: the centre of mass's apex height, located inside the simulator's step).
+    - ``reward_shaping`` (off by default): ``-shaping_reward_weight * control_dt * |h_reach -
+      h_target| / h_target`` every step, ``h_reach`` the apex the ball's free energy could reach.
+    - ``reward_termination``: on early termination, ``-termination_reward_weight`` per apex left
+      until the time limit (a resting ball misses each by about the whole target), so stopping the
+      ball or breaking the simulator never pays.
 
-            ## Starting State
-            The ball, inflated to ``initial_pressure``, at rest shape with a random rotation, centre at
-            height ``U(start_height_range)``, horizontal velocity ``U(-reset_noise_scale, reset_noise_scale)``,
-            no vertical velocity; target apex ``U(target_height_range)``.
+    ## Starting State
+    The ball, inflated to ``initial_pressure``, at rest shape with a random rotation, centre at
+    height ``U(start_height_range)``, horizontal velocity ``U(-reset_noise_scale, reset_noise_scale)``,
+    no vertical velocity; target apex ``U(target_height_range)``.
 
-            ## Episode End
-            Terminated when the ball comes to rest (it could no longer rise ``rest_height``), leaves the
-            arena (``|x| > arena_half_width`` or height above ``arena_height``), or the simulator fails
-            (``info["sim_failure"]`` True, ``info["sim_failure_reason"]`` says why; the observation is the
-            last accepted state, never NaN). Truncated by the time limit only: ``max_episode_steps=1000``
-            (10 s at 100 Hz).
+    ## Episode End
+    Terminated when the ball comes to rest (it could no longer rise ``rest_height``), leaves the
+    arena (``|x| > arena_half_width`` or height above ``arena_height``), or the simulator fails
+    (``info["sim_failure"]`` True, ``info["sim_failure_reason"]`` says why; the observation is the
+    last accepted state, never NaN). Truncated by the time limit only: ``max_episode_steps=1000``
+    (10 s at 100 Hz).
 
-            ## Arguments
-            ``gym.make("InflatedBall-v0", **kwargs)`` (or ``"ballenv:InflatedBall-v0"``, which also works in
-            spawned subprocesses).
+    ## Arguments
+    ``gym.make("InflatedBall-v0", **kwargs)`` (or ``"ballenv:InflatedBall-v0"``, which also works in
+    spawned subprocesses).
 
-            | Parameter                   | Type  | Default        | Description |
-            |-----------------------------|-------|----------------|-------------|
-            | action_mode                 | str   | "pressure"     | "pressure" or "paddle" |
-            | fidelity                    | str   | "fast"         | numerical preset: "fast", "balanced", "accurate" (README) |
-            | control_frequency           | float | 100.0          | control steps per second (Hz) |
-            | target_height_range         | tuple | (0.5, 1.0)     | target apex height of the centre (m) |
-            | start_height_range          | tuple | (0.6, 1.2)     | initial height of the centre (m) |
-            | pressure_range              | tuple | (10e3, 50e3)   | gauge pressure at rest for actions -1, +1 (Pa) |
-            | initial_pressure            | float | 30e3           | gas at reset (and always, in paddle mode) (Pa) |
-        | pressure_rate               | float | 4e5            | fastest change of the gas setpoint (Pa/s) |
-            | paddle_max_impulse          | float | 0.15           | impulse of action +1 (N s) |
-            | paddle_reach                | float | 0.4            | paddle strikes when the ball's top is this close (m) |
-            | paddle_depth                | float | 0.06           | it touches the nodes this close to the top (m) |
-            | radius                      | float | 0.12           | unstretched ring radius R (m) |
-            | youngs_modulus              | float | 10e6           | wall modulus E (Pa) |
-            | thickness                   | float | 2e-3           | wall thickness h (m) |
-            | width                       | float | 0.02           | out-of-plane width b (m) |
-            | density                     | float | 1100.0         | wall density (kg/m^3) |
-            | friction                    | float | 0.5            | Coulomb coefficient of the ground |
-            | damping                     | float | 20.0           | the wall's damping of deformation c (1/s) |
-            | gravity                     | float | 9.81           | g (m/s^2) |
-            | apex_reward_weight          | float | 1.0            | weight of reward_apex |
-            | shaping_reward_weight       | float | 0.0            | weight of reward_shaping (per second) |
-            | termination_reward_weight   | float | 1.0            | weight of reward_termination (per missed apex) |
+    | Parameter                   | Type  | Default        | Description |
+    |-----------------------------|-------|----------------|-------------|
+    | action_mode                 | str   | "pressure"     | "pressure" or "paddle" |
+    | fidelity                    | str   | "fast"         | numerical preset: "fast", "balanced", "accurate" (README) |
+    | control_frequency           | float | 100.0          | control steps per second (Hz) |
+    | target_height_range         | tuple | (0.5, 1.0)     | target apex height of the centre (m) |
+    | start_height_range          | tuple | (0.6, 1.2)     | initial height of the centre (m) |
+    | pressure_range              | tuple | (10e3, 50e3)   | gauge pressure at rest for actions -1, +1 (Pa) |
+    | initial_pressure            | float | 30e3           | gas at reset (and always, in paddle mode) (Pa) |
+    | pressure_rate               | float | 4e5            | fastest change of the gas setpoint (Pa/s) |
+    | paddle_max_impulse          | float | 0.15           | impulse of action +1 (N s) |
+    | paddle_reach                | float | 0.4            | paddle strikes when the ball's top is this close (m) |
+    | paddle_depth                | float | 0.06           | it touches the nodes this close to the top (m) |
+    | radius                      | float | 0.12           | unstretched ring radius R (m) |
+    | youngs_modulus              | float | 10e6           | wall modulus E (Pa) |
+    | thickness                   | float | 2e-3           | wall thickness h (m) |
+    | width                       | float | 0.02           | out-of-plane width b (m) |
+    | density                     | float | 1100.0         | wall density (kg/m^3) |
+    | friction                    | float | 0.5            | Coulomb coefficient of the ground |
+    | damping                     | float | 20.0           | the wall's damping of deformation c (1/s) |
+    | gravity                     | float | 9.81           | g (m/s^2) |
+    | apex_reward_weight          | float | 1.0            | weight of reward_apex |
+    | shaping_reward_weight       | float | 0.0            | weight of reward_shaping (per second) |
+    | termination_reward_weight   | float | 1.0            | weight of reward_termination (per missed apex) |
     | termination_horizon         | float | 10.0           | the termination term counts apexes missed until then (s); match your time limit |
-            | reset_noise_scale           | float | 0.05           | horizontal start speed range (m/s) |
-            | arena_half_width            | float | 3.0            | (m) |
-            | arena_height                | float | 5.0            | (m) |
-            | rest_height                 | float | 0.01           | the ball is at rest when it could rise no more (m) |
-            | render_mode                 | str   | None           | "human" or "rgb_array" |
+    | reset_noise_scale           | float | 0.05           | horizontal start speed range (m/s) |
+    | arena_half_width            | float | 3.0            | (m) |
+    | arena_height                | float | 5.0            | (m) |
+    | rest_height                 | float | 0.01           | the ball is at rest when it could rise no more (m) |
+    | render_mode                 | str   | None           | "human" or "rgb_array" |
 
-            ## Version History
-            - v0: initial release.
+    ## Version History
+    - v0: initial release.
     """
 
     metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 50}

@@ -1,0 +1,129 @@
+"""Policies for InflatedBall-v0 behind one interface: ``reset(seed)`` at an episode start, then
+``act(obs) -> action`` (float32 array of shape (1,)).
+
+* :class:`RandomPolicy`: uniform actions in [-1, 1] from its own seeded generator;
+* :class:`HeuristicPolicy`: the scripted controller of the env's action mode
+  (:class:`ballenv.controllers.PressurePump` or :class:`ballenv.controllers.PaddleDribble`);
+* :class:`ModelPolicy`: a saved Stable-Baselines3 model (deterministic actions), with the
+  observation normalisation (``VecNormalize`` statistics) it was trained with.
+"""
+
+import pathlib
+
+import numpy as np
+
+from ballenv.controllers import PaddleDribble, PressurePump
+from ballenv.physics.ring import total_mass
+
+ALGORITHMS = ("ppo", "sac")
+
+
+class RandomPolicy:
+    """Uniform random actions; the same seed gives the same actions."""
+
+    name = "random"
+
+    def __init__(self, env):
+        self.rng = np.random.default_rng(0)
+
+    def reset(self, seed):
+        self.rng = np.random.default_rng(seed)
+
+    def act(self, obs):
+        return self.rng.uniform(-1.0, 1.0, size=1).astype(np.float32)
+
+
+class HeuristicPolicy:
+    """The scripted controller of the env's action mode (pressure pumping or paddle dribbling)."""
+
+    name = "heuristic"
+
+    def __init__(self, env):
+        config = env.unwrapped.config
+        structure = env.unwrapped._structure
+        if config.action_mode == "pressure":
+            self.controller = PressurePump(structure, gravity=config.gravity)
+        else:
+            mass = total_mass(config.ring(config.initial_pressure))
+            self.controller = PaddleDribble(
+                structure, mass, gravity=config.gravity, max_impulse=config.paddle_max_impulse
+            )
+
+    def reset(self, seed):
+        self.controller.reset()
+
+    def act(self, obs):
+        return self.controller.act(obs)
+
+
+class ModelPolicy:
+    """A saved Stable-Baselines3 model (``model.zip`` of a run folder, or any path to a .zip).
+
+    The observation normalisation the model was trained with (``vecnormalize.pkl`` next to it,
+    ``best_vecnormalize.pkl`` for ``best_model.zip``) is applied frozen, if present.
+    """
+
+    name = "trained"
+
+    def __init__(self, env, path, algo=None):
+        import pickle
+
+        from stable_baselines3 import PPO, SAC
+
+        path = pathlib.Path(path)
+        if path.is_dir():
+            path = path / ("best_model.zip" if (path / "best_model.zip").exists() else "model.zip")
+        if not path.exists():
+            raise ValueError(f"agents.evaluate: policy file {str(path)!r} does not exist")
+        algo = algo or _algo_of(path)
+        cls = {"ppo": PPO, "sac": SAC}[algo]
+        self.model = cls.load(path, device="cpu")
+        self.obs_rms = None
+        self.clip_obs = 10.0
+        self.epsilon = 1e-8
+        stats = path.parent / (
+            "best_vecnormalize.pkl" if path.name == "best_model.zip" else "vecnormalize.pkl"
+        )
+        if stats.exists():
+            with open(stats, "rb") as f:
+                normalize = pickle.load(f)
+            if normalize.norm_obs:
+                self.obs_rms = normalize.obs_rms
+                self.clip_obs = normalize.clip_obs
+                self.epsilon = normalize.epsilon
+
+    def reset(self, seed):
+        pass
+
+    def act(self, obs):
+        if self.obs_rms is not None:
+            scaled = (obs - self.obs_rms.mean) / np.sqrt(self.obs_rms.var + self.epsilon)
+            obs = np.clip(scaled, -self.clip_obs, self.clip_obs).astype(np.float32)
+        action, _ = self.model.predict(obs, deterministic=True)
+        return np.asarray(action, dtype=np.float32).reshape(1)
+
+
+def _algo_of(path):
+    """The algorithm of a saved model from its run folder's config (or its file name)."""
+    config = path.parent / "config.yml"
+    if config.exists():
+        import yaml
+
+        algo = yaml.safe_load(config.read_text()).get("algo")
+        if algo in ALGORITHMS:
+            return algo
+    for algo in ALGORITHMS:
+        if algo in path.as_posix().lower():
+            return algo
+    raise ValueError(
+        f"agents.evaluate: cannot tell the algorithm of {str(path)!r}: pass --algo (one of {ALGORITHMS})"
+    )
+
+
+def make_policy(spec, env, algo=None):
+    """``"random"``, ``"heuristic"`` or a path to a saved model / run folder -> a policy."""
+    if spec == "random":
+        return RandomPolicy(env)
+    if spec == "heuristic":
+        return HeuristicPolicy(env)
+    return ModelPolicy(env, spec, algo)

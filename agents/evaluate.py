@@ -1,0 +1,168 @@
+"""Score a policy on InflatedBall-v0 over held-out episodes.
+
+    python -m agents.evaluate heuristic --action-mode pressure --episodes 20
+    python -m agents.evaluate random --action-mode paddle
+    python -m agents.evaluate runs/ppo_pressure_seed0          # a run folder of train.py
+    python -m agents.evaluate path/to/model.zip --algo sac --env-kwargs '{"action_mode": "paddle"}'
+
+Episode ``k`` is reset with seed ``seed + k`` (default 10,000 on: training uses small seeds), so
+the same arguments give the same numbers. Metrics (the reward's shaping term is ignored):
+
+* **apex error**: per episode, the mean of ``|h - h_target| / h_target`` over its flight apexes,
+  where each apex missed because the episode ended early (the ball came to rest, left the arena or
+  the simulator failed; counted as the env's termination term does, until ``termination_horizon``)
+  counts as an error of 1; reported as the mean over episodes with a 95 % confidence interval
+  (normal approximation, ``1.96 s / sqrt(n)``);
+* **success rate**: the fraction of all apexes (missed ones included) within 5 % of the target;
+* **apexes per episode** (missed ones included), **episode length** in control steps, and the mean
+  return.
+"""
+
+import argparse
+import json
+import math
+from dataclasses import asdict, dataclass
+
+import gymnasium as gym
+import numpy as np
+
+from .baselines import make_policy
+
+ENV_ID = "ballenv:InflatedBall-v0"
+SUCCESS_TOLERANCE = 0.05  # relative apex error counted as a success
+DEFAULT_SEED = 10_000
+
+
+@dataclass(frozen=True)
+class Score:
+    """Evaluation of one policy; errors are relative to the target apex height."""
+
+    policy: str
+    episodes: int
+    apex_error: float  # mean over episodes
+    apex_error_ci95: float  # half-width of its 95 % confidence interval
+    success_rate: float  # apexes within SUCCESS_TOLERANCE, of all apexes (missed ones included)
+    episode_length: float  # mean, control steps
+    episode_return: float  # mean
+    apexes: float  # mean per episode, missed ones included
+
+
+def run_episode(env, policy, seed):
+    """One episode; returns (relative apex errors, missed apexes, length, return)."""
+    obs, _ = env.reset(seed=seed)
+    policy.reset(seed)
+    config = env.unwrapped.config
+    errors = []
+    total = 0.0
+    length = 0
+    missed = 0
+    while True:
+        obs, reward, terminated, truncated, info = env.step(policy.act(obs))
+        total += reward
+        length += 1
+        if info["apex_count"]:
+            errors.append(abs(info["apex_height"] - info["target_height"]) / info["target_height"])
+        if terminated and config.termination_reward_weight > 0.0:
+            missed = int(round(-info["reward_termination"] / config.termination_reward_weight))
+        if terminated or truncated:
+            return errors, missed, length, total
+
+
+def evaluate(policy, env_kwargs=None, episodes=20, seed=DEFAULT_SEED, algo=None, progress=False):
+    """Score ``policy`` ("random", "heuristic", or a saved model / run folder) over ``episodes``
+    episodes of ``gym.make(ENV_ID, **env_kwargs)`` seeded ``seed, seed + 1, ...``."""
+    env = gym.make(ENV_ID, **(env_kwargs or {}))
+    agent = make_policy(policy, env, algo)
+    per_episode, hits, apexes, lengths, returns = [], 0, 0, [], []
+    seeds = range(seed, seed + episodes)
+    if progress:
+        from tqdm.auto import tqdm
+
+        seeds = tqdm(seeds, desc=f"evaluate {agent.name}", unit="episode")
+    for s in seeds:
+        errors, missed, length, total = run_episode(env, agent, s)
+        count = len(errors) + missed
+        per_episode.append((sum(errors) + missed) / count if count else 1.0)
+        hits += sum(e <= SUCCESS_TOLERANCE for e in errors)
+        apexes += count
+        lengths.append(length)
+        returns.append(total)
+    env.close()
+    err = np.array(per_episode)
+    half = 1.96 * err.std(ddof=1) / math.sqrt(len(err)) if len(err) > 1 else math.nan
+    return Score(
+        policy=agent.name if policy in ("random", "heuristic") else str(policy),
+        episodes=episodes,
+        apex_error=float(err.mean()),
+        apex_error_ci95=float(half),
+        success_rate=hits / apexes if apexes else 0.0,
+        episode_length=float(np.mean(lengths)),
+        episode_return=float(np.mean(returns)),
+        apexes=apexes / episodes,
+    )
+
+
+def table(scores):
+    """Markdown table of scores."""
+    lines = [
+        "| policy | episodes | apex error (mean +- 95 % CI) | apexes within 5 % | apexes per episode "
+        "| episode length | return |",
+        "|---|---:|---:|---:|---:|---:|---:|",
+    ]
+    for s in scores:
+        lines.append(
+            f"| {s.policy} | {s.episodes} | {s.apex_error:.3f} +- {s.apex_error_ci95:.3f} | "
+            f"{100 * s.success_rate:.1f} % | {s.apexes:.1f} | {s.episode_length:.0f} | "
+            f"{s.episode_return:.2f} |"
+        )
+    return "\n".join(lines)
+
+
+def parse_env_kwargs(text):
+    """``--env-kwargs`` as a JSON object (e.g. '{"action_mode": "paddle"}')."""
+    try:
+        value = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise SystemExit(f"--env-kwargs = {text!r} is not a JSON object: {exc}") from exc
+    if not isinstance(value, dict):
+        raise SystemExit(f"--env-kwargs = {text!r} must be a JSON object of env keyword arguments")
+    return value
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="python -m agents.evaluate", description=__doc__.split("\n")[0])
+    parser.add_argument("policy", help='"random", "heuristic", a model .zip or a run folder of train.py')
+    parser.add_argument("--action-mode", choices=("pressure", "paddle"), help="shortcut for env_kwargs")
+    parser.add_argument("--env-kwargs", type=parse_env_kwargs, default=None, help="JSON object")
+    parser.add_argument("--episodes", type=int, default=20, help="held-out episodes (default 20)")
+    parser.add_argument("--seed", type=int, default=DEFAULT_SEED, help="seed of the first episode")
+    parser.add_argument("--algo", choices=("ppo", "sac"), help="algorithm of a bare model .zip")
+    parser.add_argument("--json", help="also write the score to this file")
+    args = parser.parse_args(argv)
+    env_kwargs = dict(args.env_kwargs or {})
+    if args.env_kwargs is None and args.policy not in ("random", "heuristic"):
+        env_kwargs = _run_env_kwargs(args.policy)
+    if args.action_mode:
+        env_kwargs["action_mode"] = args.action_mode
+    score = evaluate(args.policy, env_kwargs, args.episodes, args.seed, args.algo, progress=True)
+    print(table([score]))
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(asdict(score), f, indent=2)
+
+
+def _run_env_kwargs(policy):
+    """The env keyword arguments a run folder of train.py was trained with (else none)."""
+    import pathlib
+
+    import yaml
+
+    path = pathlib.Path(policy)
+    config = (path if path.is_dir() else path.parent) / "config.yml"
+    if not config.exists():
+        return {}
+    return dict(yaml.safe_load(config.read_text()).get("env_kwargs") or {})
+
+
+if __name__ == "__main__":
+    main()
