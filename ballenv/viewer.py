@@ -55,7 +55,9 @@ def viewer_data(traj, max_frames=2000, title=None):
         "x": _b64(traj.x[idx]),
         "f": _b64(traj.contact_force[idx]),
         "p": _b64(traj.pressure[idx]),
-        "grounds": [{"angle": g.angle, "height": g.height, "x": g.x, "friction": g.friction} for g in scene.grounds],
+        "grounds": [
+            {"angle": g.angle, "height": g.height, "x": g.x, "friction": g.friction} for g in scene.grounds
+        ],
         "radius": [r.radius for r in scene.rings],
         "events": [[float(t), int(r), k] for t, r, k in traj.events],
         "info": (
@@ -198,7 +200,9 @@ def main(argv=None):
     )
     parser.add_argument("trajectory", help="a Trajectory.save file (.npz)")
     parser.add_argument("-o", "--out", default="replay.html", help="HTML file to write (default replay.html)")
-    parser.add_argument("--max-frames", type=int, default=2000, help="records kept, evenly in time (default 2000)")
+    parser.add_argument(
+        "--max-frames", type=int, default=2000, help="records kept, evenly in time (default 2000)"
+    )
     parser.add_argument("--title", default=None, help="page title (default: the file name)")
     args = parser.parse_args(argv)
     try:
@@ -208,7 +212,9 @@ def main(argv=None):
         return 2
     path = write_html(traj, args.out, args.max_frames, args.title or pathlib.Path(args.trajectory).name)
     size = path.stat().st_size
-    print(f"wrote {path} ({size / 1e6:.2f} MB, {math.ceil(min(len(traj.t), args.max_frames))} records at most)")
+    print(
+        f"wrote {path} ({size / 1e6:.2f} MB, {math.ceil(min(len(traj.t), args.max_frames))} records at most)"
+    )
     return 0
 
 

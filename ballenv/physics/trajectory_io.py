@@ -114,7 +114,9 @@ def load(path):
             )
         version = int(archive["version"]) if "version" in keys else None
         if version != VERSION:
-            raise ValueError(f"Trajectory.load: {path} has layout version {version}, this ballenv reads {VERSION}")
+            raise ValueError(
+                f"Trajectory.load: {path} has layout version {version}, this ballenv reads {VERSION}"
+            )
         missing = [k for k in (*ARRAYS, "scene", "stats") if k not in keys]
         if missing:
             raise ValueError(f"Trajectory.load: {path} lacks {', '.join(missing)}")
@@ -134,9 +136,15 @@ def load(path):
     }
     for key, shape in shapes.items():
         if arrays[key].shape != shape:
-            raise ValueError(f"Trajectory.load: {path}: {key} has shape {arrays[key].shape}, expected {shape}")
+            raise ValueError(
+                f"Trajectory.load: {path}: {key} has shape {arrays[key].shape}, expected {shape}"
+            )
     table = arrays["event_table"]
-    if table.ndim != 2 or table.shape[1] != 4 or np.any((table[:, 2] < 0) | (table[:, 2] >= len(EVENT_KINDS))):
+    if (
+        table.ndim != 2
+        or table.shape[1] != 4
+        or np.any((table[:, 2] < 0) | (table[:, 2] >= len(EVENT_KINDS)))
+    ):
         raise ValueError(f"Trajectory.load: {path}: event_table must be (E, 4) rows with known event kinds")
     stats["effects"] = tuple(stats["effects"])
     return Trajectory(

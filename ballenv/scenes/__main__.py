@@ -48,7 +48,9 @@ def run_one(name, out, fidelity="balanced", reduced=False, video=True, save=True
     if video and result.animate:
         trajs = [result.trajectories[label] for label in result.animate]
         paths.append(
-            write_gif(trajs, out / f"{name}.gif", labels=list(result.animate), n_frames=frames, progress=progress)
+            write_gif(
+                trajs, out / f"{name}.gif", labels=list(result.animate), n_frames=frames, progress=progress
+            )
         )
     record = {
         "scene": name,
@@ -70,7 +72,7 @@ def run_one(name, out, fidelity="balanced", reduced=False, video=True, save=True
 def main(argv=None):
     parser = argparse.ArgumentParser(
         prog="python -m ballenv.scenes",
-        description="Run named scenes of the paper; write figure (PNG), video (GIF), numbers (JSON), trajectories.",
+        description="Run named scenes of the paper: figure (PNG), video (GIF), numbers (JSON), trajectories.",
     )
     parser.add_argument("names", nargs="*", metavar="NAME", help="scene name(s), or 'all'; see --list")
     parser.add_argument("--list", action="store_true", help="list the scenes and exit")

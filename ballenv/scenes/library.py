@@ -446,7 +446,12 @@ def slope_spin(fidelity="balanced", reduced=False, progress=False):
     trajectories = {}
     for w in spins:
         ring = Ring(
-            radius=0.1, thickness=2e-3, youngs_modulus=10e6, pressure=30e3, position=(0.0, 0.5), angular_velocity=w
+            radius=0.1,
+            thickness=2e-3,
+            youngs_modulus=10e6,
+            pressure=30e3,
+            position=(0.0, 0.5),
+            angular_velocity=w,
         )
         scene = Scene(rings=[ring], grounds=[Ground(angle=slope, friction=mu)])
         traj = _run(scene, 0.55, fidelity, progress, output_dt=1e-3)
