@@ -139,7 +139,7 @@ def _rolling(plt, res):
     ax.plot(E, m["height_over_diameter"], "o-", color="tab:red")
     ax.set_xlabel("E (MPa)")
     ax.set_ylabel("rolling height / rest diameter")
-    ax.set_title("height grows with E (slope frame, last 0.5 s)", fontsize=10)
+    ax.set_title("height grows with E", fontsize=10)
     return fig
 
 
@@ -160,7 +160,7 @@ def _variable_inflation(plt, res):
     axes[1].set_yscale("log")
     axes[1].set_xlabel("t (s)")
     axes[1].set_ylabel("gauge pressure (kPa)")
-    axes[1].set_title("pressure: gas law spikes at each impact")
+    axes[1].set_title("pressure: each pump rings the wall; impacts raise it (gas law)", fontsize=10)
     return fig
 
 
