@@ -6,7 +6,7 @@ PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 export OPENBLAS_NUM_THREADS := 1
 
-.PHONY: venv train demo test test-slow bench lint format clean
+.PHONY: venv train browser demo scenes test test-slow bench lint format clean
 
 $(STAMP): pyproject.toml constraints.txt
 	$(PYTHON) -m venv $(VENV)
@@ -19,13 +19,28 @@ venv: $(STAMP)
 train: $(STAMP)
 	$(PY) train.py --algo ppo --action-mode pressure --log-dir runs
 
+# Debian's chromium, for the replay viewer's browser test (tests/test_viewer.py, which fails under
+# CI without it); installed with apt-get when absent (as root, or through sudo). A failed install
+# is reported and the other tests still run.
+SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
+browser:
+	@command -v chromium >/dev/null 2>&1 || { \
+		echo "installing Debian's chromium for the viewer test"; \
+		$(SUDO) apt-get update -qq && \
+		DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq chromium >/dev/null; } || \
+		echo "WARNING: could not install chromium (apt-get failed): tests/test_viewer.py's browser test will fail under CI"
+	@chromium --version 2>/dev/null || true
+
 demo: $(STAMP)
 	$(PY) -m ballenv.demo --out out
 
-test: $(STAMP)
+scenes: $(STAMP)
+	$(PY) -m ballenv.scenes all --out docs/figures --no-trajectories
+
+test: $(STAMP) browser
 	$(PY) -m pytest -q
 
-test-slow: $(STAMP)
+test-slow: $(STAMP) browser
 	$(PY) -m pytest -q -m slow
 
 bench: $(STAMP)

@@ -113,6 +113,20 @@ class Trajectory:
         """
         return energy(self.scene, self.x, self.v)
 
+    def save(self, path):
+        """Write this trajectory to ``path`` (a compressed ``.npz``; layout in
+        :mod:`ballenv.physics.trajectory_io`); returns the path written."""
+        from .trajectory_io import save
+
+        return save(self, path)
+
+    @classmethod
+    def load(cls, path):
+        """A trajectory saved by :meth:`save`, exactly as it was (ValueError on a foreign file)."""
+        from .trajectory_io import load
+
+        return load(path)
+
 
 def energy(scene, x, v):
     """Mechanical plus gas energy (J) of states ``x, v`` (..., n_rings, n_nodes, 2); see Trajectory."""

@@ -1,0 +1,115 @@
+"""Run a named scene and write its figure, video, measured numbers and trajectories.
+
+    python -m ballenv.scenes --list
+    python -m ballenv.scenes NAME [NAME ...] --out DIR [--fidelity balanced] [--reduced] [--no-video]
+
+Writes, in DIR: ``NAME.png`` (the figure), ``NAME.gif`` (the video), ``NAME.json`` (parameters and
+measured numbers, SI units) and ``NAME-LABEL.npz`` per simulation (``Trajectory.load``; replay with
+``python -m ballenv.viewer DIR/NAME-LABEL.npz -o replay.html``). ``all`` runs every scene.
+"""
+
+import argparse
+import json
+import os
+import pathlib
+import re
+import sys
+import time
+
+from . import SCENES, get
+
+
+def _slug(label):
+    return re.sub(r"[^A-Za-z0-9.+-]+", "_", label).strip("_")
+
+
+def _jsonable(value):
+    if isinstance(value, dict):
+        return {str(k): _jsonable(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_jsonable(v) for v in value]
+    if hasattr(value, "tolist"):
+        return value.tolist()
+    return value
+
+
+def run_one(name, out, fidelity="balanced", reduced=False, video=True, save=True, frames=120, progress=True):
+    """Run scene ``name`` and write its files into ``out``; returns the written paths."""
+    from .animate import write_gif
+    from .figures import plot
+
+    info = get(name)
+    out = pathlib.Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    start = time.perf_counter()
+    result = info.run(fidelity=fidelity, reduced=reduced, progress=progress)
+    wall = time.perf_counter() - start
+    paths = [plot(result, out / f"{name}.png")]
+    if video and result.animate:
+        trajs = [result.trajectories[label] for label in result.animate]
+        paths.append(
+            write_gif(
+                trajs, out / f"{name}.gif", labels=list(result.animate), n_frames=frames, progress=progress
+            )
+        )
+    record = {
+        "scene": name,
+        "figure": info.figure,
+        "fidelity": fidelity,
+        "reduced": reduced,
+        "wall_time_s": wall,
+        "parameters": _jsonable(result.parameters),
+        "metrics": _jsonable(result.metrics),
+    }
+    (out / f"{name}.json").write_text(json.dumps(record, indent=1))
+    paths.append(out / f"{name}.json")
+    if save:
+        for label, traj in result.trajectories.items():
+            paths.append(traj.save(out / f"{name}-{_slug(label)}.npz"))
+    return paths
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(
+        prog="python -m ballenv.scenes",
+        description="Run named scenes of the paper: figure (PNG), video (GIF), numbers (JSON), trajectories.",
+    )
+    parser.add_argument("names", nargs="*", metavar="NAME", help="scene name(s), or 'all'; see --list")
+    parser.add_argument("--list", action="store_true", help="list the scenes and exit")
+    parser.add_argument("--out", default="out/scenes", help="output folder (default: out/scenes)")
+    parser.add_argument("--fidelity", default="balanced", choices=("fast", "balanced", "accurate"))
+    parser.add_argument("--reduced", action="store_true", help="fewer cases (as the tests run them)")
+    parser.add_argument("--no-video", action="store_true", help="skip the GIF")
+    parser.add_argument("--no-trajectories", action="store_true", help="do not save the .npz trajectories")
+    parser.add_argument("--frames", type=int, default=120, help="frames of the GIF (default 120)")
+    args = parser.parse_args(argv)
+    if args.list or not args.names:
+        width = max(len(n) for n in SCENES)
+        for info in SCENES.values():
+            print(f"{info.name:<{width}}  {info.figure:<7} {info.summary}")
+        return 0
+    names = list(SCENES) if args.names == ["all"] else args.names
+    for name in names:
+        try:
+            get(name)
+        except ValueError as err:
+            parser.error(str(err))
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+    for name in names:
+        print(f"== {name}", flush=True)
+        paths = run_one(
+            name,
+            args.out,
+            fidelity=args.fidelity,
+            reduced=args.reduced,
+            video=not args.no_video,
+            save=not args.no_trajectories,
+            frames=args.frames,
+        )
+        for p in paths:
+            print(f"wrote {p}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,519 @@
+"""The scenes: each builds its scenes, simulates them, and measures what the figure claims.
+
+Every function takes ``fidelity`` (a preset of :mod:`ballenv.physics.presets`: "fast" |
+"balanced" | "accurate"), ``reduced`` (fewer cases, for the tests) and ``progress`` (a progress
+bar per simulation), and returns a :class:`SceneResult`. All parameters are SI (m, Pa, kg/m^3, m/s,
+rad, rad/s, s); each scene's are listed in its docstring and in ``SceneResult.parameters``.
+"""
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..physics import Ground, Ring, Scene, Trajectory, simulate
+from ..physics.presets import with_fidelity
+from ..physics.ring import bending_stiffness, inflated_radius, total_mass
+
+G = 9.81  # m/s^2
+
+
+@dataclass
+class SceneResult:
+    """What a scene ran and measured.
+
+    Attributes:
+        name: the scene's name.
+        parameters: the scene's inputs (SI units), as documented in its function.
+        metrics: the numbers it measured (SI units unless the key says otherwise).
+        trajectories: label -> :class:`Trajectory` of each simulation.
+        animate: labels of the trajectories the video shows side by side.
+    """
+
+    name: str
+    parameters: dict
+    metrics: dict
+    trajectories: dict = field(default_factory=dict)
+    animate: tuple = ()
+
+
+def _run(scene, t_end, fidelity, progress, output_dt=None):
+    return simulate(with_fidelity(scene, fidelity), t_end, output_dt=output_dt, progress=progress)
+
+
+def _drop_height_start(ring_kw, height):
+    """Ring keywords with the centre at ``height`` (m)."""
+    return {**ring_kw, "position": (0.0, height)}
+
+
+# ---------------------------------------------------------------- shape measures
+
+
+def turning_angles(x):
+    """Signed turning angle (rad) at each node of the closed polygon ``x`` (N, 2)."""
+    edge = np.roll(x, -1, axis=0) - x
+    angle = np.arctan2(edge[:, 1], edge[:, 0])
+    return np.angle(np.exp(1j * (angle - np.roll(angle, 1))))
+
+
+def shape_measures(x, normal=(0.0, 1.0)):
+    """Measures (dimensionless unless stated) of one ring shape ``x`` (N, 2) on a ground of unit
+    ``normal``:
+
+    * ``height`` (m): extent along the normal; ``width`` (m): extent along the surface;
+      ``aspect``: width / height.
+    * ``curvature_top`` / ``curvature_side``: mean turning angle of the 7 nodes farthest from the
+      ground / farthest to the side, over the regular polygon's 2 pi / N; 1 on a circle.
+    * ``patch`` (m): length along the surface of the nodes within 1 % of the height of the ground
+      (the flattened contact patch).
+    """
+    n = np.asarray(normal, dtype=float)
+    s = np.array([n[1], -n[0]])
+    up = x @ n
+    along = x @ s
+    height = up.max() - up.min()
+    width = along.max() - along.min()
+    kappa = turning_angles(x) / (2.0 * math.pi / len(x))
+    kappa *= np.sign(kappa.sum())
+    k = min(7, len(x) // 4)
+    top = np.argsort(-up)[:k]
+    side = np.argsort(-np.abs(along - along.mean()))[:k]
+    near = up < up.min() + 0.01 * height
+    return {
+        "height": float(height),
+        "width": float(width),
+        "aspect": float(width / height),
+        "curvature_top": float(kappa[top].mean()),
+        "curvature_side": float(kappa[side].mean()),
+        "patch": float(along[near].max() - along[near].min()),
+    }
+
+
+def rigid_motion(x, v):
+    """Centre-of-mass velocity (2,) m/s and spin (rad/s, counter-clockwise) of a ring of equal node
+    masses from its nodes ``x, v`` (N, 2)."""
+    c = x.mean(axis=0)
+    u = v.mean(axis=0)
+    r = x - c
+    w = v - u
+    spin = np.sum(r[:, 0] * w[:, 1] - r[:, 1] * w[:, 0]) / np.sum(r * r)
+    return u, float(spin)
+
+
+def first_event(traj, kind, after=-math.inf, ring=0):
+    """Time (s) of the first event ``kind`` of ``ring`` after ``after``, or None."""
+    for t, r, k in traj.events:
+        if k == kind and r == ring and t > after:
+            return t
+    return None
+
+
+# ---------------------------------------------------------------- figure 6
+
+
+def bounce_vs_pressure(fidelity="balanced", reduced=False, progress=False):
+    """Figure 6: first-bounce apex against inflation pressure, for E = 10 and 25 MPa.
+
+    A ring (R = 0.1 m, h = 2 mm, b = 2 cm, rho = 1100 kg/m^3) is released at rest with its centre
+    at 1 m above flat frictionless ground, no damping; the apex of its centre after the first
+    bounce is located inside the step. Pressures 5, 10, 20, 30, 45, 60 kPa (reduced: 10, 30,
+    60 kPa). Claim (the paper): the apex rises with pressure, more for the softer wall.
+    """
+    moduli = (10e6, 25e6)
+    pressures = (10e3, 30e3, 60e3) if reduced else (5e3, 10e3, 20e3, 30e3, 45e3, 60e3)
+    ring_kw = {"radius": 0.1, "thickness": 2e-3, "width": 0.02, "density": 1100.0, "position": (0.0, 1.0)}
+    apex = {}
+    trajectories = {}
+    for E in moduli:
+        row = []
+        for p in pressures:
+            scene = Scene(rings=[Ring(youngs_modulus=E, pressure=p, **ring_kw)], grounds=[Ground()])
+            traj = _run(scene, 0.95, fidelity, progress)
+            row.append(float(traj.apexes()[0, 1]))
+            trajectories[f"E={E / 1e6:g}MPa p={p / 1e3:g}kPa"] = traj
+        apex[E] = row
+    metrics = {
+        "pressure_Pa": list(pressures),
+        "apex_m": {f"{E / 1e6:g} MPa": apex[E] for E in moduli},
+        "apex_rise_m": {f"{E / 1e6:g} MPa": apex[E][-1] - apex[E][0] for E in moduli},
+    }
+    labels = (f"E=10MPa p={pressures[0] / 1e3:g}kPa", f"E=10MPa p={pressures[-1] / 1e3:g}kPa")
+    return SceneResult(
+        "bounce-vs-pressure",
+        {"youngs_modulus": list(moduli), "pressure": list(pressures), **ring_kw, "drop_height": 1.0},
+        metrics,
+        trajectories,
+        labels,
+    )
+
+
+# ---------------------------------------------------------------- figure 5
+
+
+def bounce_strip(fidelity="balanced", reduced=False, progress=False):
+    """Figure 5: frames of one bounce, 0.015 s apart.
+
+    Ring R = 0.1 m, h = 2 mm, E = 10 MPa, p = 10 kPa (a soft ball, so the flattening shows),
+    released at rest with its centre at 0.6 m above flat ground (friction 0.5), no damping.
+    Frames every 15 ms from 45 ms before touch-down to 60 ms after lift-off.
+    """
+    interval = 0.015
+    ring = Ring(radius=0.1, thickness=2e-3, youngs_modulus=10e6, pressure=10e3, position=(0.0, 0.6))
+    scene = Scene(rings=[ring], grounds=[Ground(friction=0.5)])
+    traj = _run(scene, 0.8, fidelity, progress, output_dt=5e-4)
+    touch = first_event(traj, "touchdown")
+    lift = first_event(traj, "liftoff", after=touch)
+    times = np.arange(touch - 3 * interval, lift + 4 * interval + 1e-9, interval)
+    times = times[(times >= 0.0) & (times <= traj.t[-1])]
+    frames = [int(np.argmin(np.abs(traj.t - t))) for t in times]
+    squash = [shape_measures(traj.x[k, 0])["height"] for k in range(len(traj.t))]
+    metrics = {
+        "touchdown_s": touch,
+        "liftoff_s": lift,
+        "contact_duration_s": lift - touch,
+        "max_compression": 1.0 - min(squash) / squash[0],
+        "first_apex_m": float(traj.apexes()[0, 1]),
+        "frame_times_s": [float(traj.t[k]) for k in frames],
+        "frame_indices": frames,
+    }
+    params = {**dataclasses.asdict(ring), "friction": 0.5, "frame_interval": interval}
+    return SceneResult("bounce-strip", params, metrics, {"bounce": traj}, ("bounce",))
+
+
+# ---------------------------------------------------------------- figure 7
+
+BASKETBALL = {"radius": 0.12, "thickness": 2e-3, "youngs_modulus": 25e6, "pressure": 30e3}
+TENNIS_BALL = {"radius": 0.05, "thickness": 6e-3, "youngs_modulus": 10e6, "pressure": 4e3}
+
+
+def pressure_bending_number(ring):
+    """``p R^3 / (EI / b)`` (dimensionless): gas pressure against wall bending; a pressurised ring
+    buckles at 3, so >> 3 is gas-dominated (a basketball), <~ 3 bending-dominated (a tennis ball)."""
+    return ring.pressure * ring.radius**3 * ring.width / bending_stiffness(ring)
+
+
+def deformation(fidelity="balanced", reduced=False, progress=False, speed=3.0):
+    """Figure 7: a basketball and a tennis ball hit the ground at the same speed.
+
+    Basketball-like ring: R = 0.12 m, h = 2 mm, E = 25 MPa, p = 30 kPa (p R^3 / EI ~ 3100 >> 3:
+    the gas carries the load). Tennis-ball-like ring: R = 5 cm, h = 6 mm, E = 10 MPa, p = 4 kPa
+    (p R^3 / EI ~ 2.8 <~ 3: the wall's bending carries it). Both b = 2 cm, rho = 1100 kg/m^3,
+    start 5 mm above frictionless ground moving down at ``speed`` (3 m/s), gravity on, no damping.
+    Measured at the largest compression (smallest height): aspect ratio width / height, the wall's
+    curvature at the top and at the sides relative to a circle's, and the contact patch. Claim
+    (Stronge, the paper): the basketball flattens locally (a flat patch; the free wall stays a
+    circle, top and side curvatures ~1, little aspect change) and the tennis ball deforms globally
+    into an oval (aspect well above 1, flattened top, sharper sides).
+    """
+    cases = {"basketball": BASKETBALL, "tennis ball": TENNIS_BALL}
+    metrics = {}
+    trajectories = {}
+    for label, kw in cases.items():
+        probe = Ring(width=0.02, density=1100.0, **kw)
+        r = inflated_radius(probe)
+        ring = dataclasses.replace(probe, position=(0.0, r + 0.005), velocity=(0.0, -speed))
+        traj = _run(Scene(rings=[ring], grounds=[Ground()]), 0.08, fidelity, progress, output_dt=2e-4)
+        heights = [shape_measures(x)["height"] for x in traj.x[:, 0]]
+        k = int(np.argmin(heights))
+        m = shape_measures(traj.x[k, 0])
+        rest = shape_measures(traj.x[0, 0])
+        metrics[label] = {
+            "p_R3_over_EI": pressure_bending_number(ring),
+            "time_of_max_compression_s": float(traj.t[k]),
+            "compression": 1.0 - m["height"] / rest["height"],
+            "aspect": m["aspect"],
+            "aspect_change": m["aspect"] - rest["aspect"],
+            "curvature_top": m["curvature_top"],
+            "curvature_side": m["curvature_side"],
+            "curvature_side_over_top": m["curvature_side"] / m["curvature_top"],
+            "patch_over_width": m["patch"] / m["width"],
+            "frame_index": k,
+        }
+        trajectories[label] = traj
+    params = {label: {**kw, "width": 0.02, "density": 1100.0} for label, kw in cases.items()}
+    params["impact_speed"] = speed
+    return SceneResult("deformation", params, metrics, trajectories, tuple(cases))
+
+
+# ---------------------------------------------------------------- figure 8
+
+
+def rolling(fidelity="balanced", reduced=False, progress=False):
+    """Figure 8: unpressurised rings rolling down a slope, E = 2, 4, 6, 8 MPa (after Raux et al.).
+
+    Ring R = 0.1 m, h = 5 mm, b = 2 cm, rho = 1100 kg/m^3, no gas; slope 0.15 rad with friction
+    0.8; deformation damping 20 1/s (rolling is not damped); released at rest 3 mm above the slope
+    as a circle, it sags under its own weight and rolls. The elasto-gravity number
+    ``rho g h R^3 / (EI / b) = 12 rho g R^3 / (E h^2)`` is 2.6, 1.3, 0.86, 0.65. Measured: the rolling
+    shape's height (across the slope) over the rest diameter, averaged over the last 0.5 s of
+    2 s (reduced: of 1.5 s), and the rolling speed then. Claim (Raux et al., the paper): the height
+    grows with E.
+    """
+    moduli = (2e6, 4e6, 6e6, 8e6)
+    slope, radius, thickness, t_end = 0.15, 0.1, 5e-3, 1.5 if reduced else 2.0
+    n = np.array([-math.sin(slope), math.cos(slope)])
+    tangent = np.array([math.cos(slope), math.sin(slope)])
+    heights, speeds, numbers = [], [], []
+    trajectories = {}
+    for E in moduli:
+        centre = tuple((radius + 0.003) * n)
+        ring = Ring(radius=radius, thickness=thickness, youngs_modulus=E, pressure=None, position=centre)
+        scene = Scene(rings=[ring], grounds=[Ground(angle=slope, friction=0.8)], damping=20.0)
+        traj = _run(scene, t_end, fidelity, progress, output_dt=5e-3)
+        last = traj.t > t_end - 0.5
+        up = traj.x[:, 0] @ n
+        heights.append(float(np.mean(up.max(axis=1)[last] - up.min(axis=1)[last]) / (2 * radius)))
+        com = traj.centre_of_mass()[:, 0] @ tangent
+        speeds.append(float(-np.polyfit(traj.t[last], com[last], 1)[0]))
+        numbers.append(12 * ring.density * G * radius**3 / (E * thickness**2))
+        trajectories[f"E={E / 1e6:g}MPa"] = traj
+    metrics = {
+        "youngs_modulus_Pa": list(moduli),
+        "height_over_diameter": heights,
+        "rolling_speed_m_per_s": speeds,
+        "elastogravity_number": numbers,
+    }
+    params = {
+        "youngs_modulus": list(moduli),
+        "radius": radius,
+        "thickness": thickness,
+        "width": 0.02,
+        "density": 1100.0,
+        "slope": slope,
+        "friction": 0.8,
+        "damping": 20.0,
+        "t_end": t_end,
+    }
+    return SceneResult("rolling", params, metrics, trajectories, tuple(trajectories))
+
+
+# ---------------------------------------------------------------- variable inflation
+
+
+def _concatenate(parts, scene):
+    """One trajectory of consecutive ``parts`` (their times already shifted), on ``scene``."""
+    table = np.concatenate([p.event_table for p in parts if p.event_table is not None and len(p.event_table)])
+    from ..physics.events import event_list
+    from ..physics.simulate import SimulationStats
+
+    s = [p.stats for p in parts]
+    stats = SimulationStats(
+        steps=sum(x.steps for x in s),
+        rejected_steps=sum(x.rejected_steps for x in s),
+        newton_iterations=sum(x.newton_iterations for x in s),
+        wall_time=sum(x.wall_time for x in s),
+        effects=s[0].effects,
+        integrator=s[0].integrator,
+        rejections={k: sum(x.rejections.get(k, 0) for x in s) for k in s[0].rejections},
+    )
+    return Trajectory(
+        t=np.concatenate([p.t for p in parts]),
+        x=np.concatenate([p.x for p in parts]),
+        v=np.concatenate([p.v for p in parts]),
+        pressure=np.concatenate([p.pressure for p in parts]),
+        contact_force=np.concatenate([p.contact_force for p in parts]),
+        events=event_list(table),
+        stats=stats,
+        scene=scene,
+        event_table=table,
+    )
+
+
+def pumped_bounces(schedule, fidelity, progress, ring_kw, damping, output_dt=1e-3):
+    """A ring bounced on flat ground whose gas is set, at each apex, to the next amount of
+    ``schedule`` (gauge pressures at rest, Pa): between bounces the simulation restarts from the
+    state at the apex with the new gas amount (as :func:`ballenv.physics.actuation.set_rest_pressure`
+    does). Returns one :class:`Trajectory` (the first stage's scene) and the switch times (s)."""
+    x0 = v0 = None
+    t0 = 0.0
+    parts, switches = [], []
+    first_scene = None
+    for k, p in enumerate(schedule):
+        scene = with_fidelity(
+            Scene(rings=[Ring(pressure=p, **ring_kw)], grounds=[Ground(friction=0.5)], damping=damping),
+            fidelity,
+        )
+        first_scene = first_scene or scene
+        height = ring_kw["position"][1] if x0 is None else float(x0[..., 1].mean())
+        t_stage = 2.0 * math.sqrt(2.0 * max(height, 0.05) / G) + 0.15
+        part = simulate(scene, t_stage, x0=x0, v0=v0, output_dt=output_dt, progress=progress)
+        lift = first_event(part, "liftoff")
+        apex = first_event(part, "apex", after=lift) if lift is not None else None
+        last = k == len(schedule) - 1
+        if apex is None or last:
+            cut = len(part.t)
+        else:
+            cut = int(np.searchsorted(part.t, apex)) + 1
+        rows = part.event_table[part.event_table[:, 0] < (part.t[cut - 1] + 1e-12)].copy()
+        rows[:, 0] += t0
+        piece = Trajectory(
+            t=part.t[:cut] + t0,
+            x=part.x[:cut],
+            v=part.v[:cut],
+            pressure=part.pressure[:cut],
+            contact_force=part.contact_force[:cut],
+            events=[],
+            stats=part.stats,
+            scene=scene,
+            event_table=rows,
+        )
+        parts.append(piece)
+        if apex is None or last:
+            break
+        x0, v0 = part.x[cut - 1], part.v[cut - 1]
+        t0 += part.t[cut - 1]
+        switches.append(t0)
+        # the restart's first record repeats the cut state: drop it from the next part
+        parts[-1] = dataclasses.replace(
+            piece,
+            t=piece.t[:-1],
+            x=piece.x[:-1],
+            v=piece.v[:-1],
+            pressure=piece.pressure[:-1],
+            contact_force=piece.contact_force[:-1],
+        )
+    return _concatenate(parts, first_scene), switches
+
+
+def variable_inflation(fidelity="balanced", reduced=False, progress=False):
+    """A variable-inflation ball: gas pumped in at each apex, against the same ball left alone.
+
+    Ring R = 0.1 m, h = 2 mm, E = 10 MPa, b = 2 cm, rho = 1100 kg/m^3, released at rest with its
+    centre at 1 m over flat ground (friction 0.5), deformation damping 20 1/s (the env's). The
+    pumped ball's gas is set at its successive apexes to 10, 20, 30, 45, 60 kPa gauge at rest
+    (reduced: 10, 30, 60 kPa); the other keeps 10 kPa. In contact the gas law
+    ``(p + p_atm) A = const`` raises the pressure as the ball squashes (the pressure trace). Measured:
+    each apex of the centre, and its height above the centre of the ball resting on its inflated
+    circle (``inflated_radius``, larger with more gas). Claim: more gas, livelier bounces, so the
+    pumped ball's bounces rise higher above its resting centre than the unpumped ball's.
+    """
+    schedule = (10e3, 30e3, 60e3) if reduced else (10e3, 20e3, 30e3, 45e3, 60e3)
+    ring_kw = {
+        "radius": 0.1,
+        "thickness": 2e-3,
+        "youngs_modulus": 10e6,
+        "width": 0.02,
+        "density": 1100.0,
+        "position": (0.0, 1.0),
+    }
+    damping = 20.0
+    pumped, switches = pumped_bounces(schedule, fidelity, progress, ring_kw, damping)
+    constant, _ = pumped_bounces(schedule[:1] * len(schedule), fidelity, progress, ring_kw, damping)
+    n = len(schedule)
+    rest = [inflated_radius(Ring(pressure=p, **ring_kw)) for p in schedule]
+    pumped_apex = pumped.apexes()[:n, 1]
+    constant_apex = constant.apexes()[:n, 1]
+    metrics = {
+        "schedule_Pa": list(schedule),
+        "switch_times_s": switches,
+        "rest_centre_height_m": rest,
+        "pumped_apex_m": pumped_apex.tolist(),
+        "constant_apex_m": constant_apex.tolist(),
+        "pumped_rise_above_rest_m": (pumped_apex - np.array(rest[: len(pumped_apex)])).tolist(),
+        "constant_rise_above_rest_m": (constant_apex - rest[0]).tolist(),
+        "peak_pressure_Pa": float(pumped.pressure.max()),
+    }
+    params = {**ring_kw, "schedule": list(schedule), "damping": damping, "friction": 0.5}
+    return SceneResult(
+        "variable-inflation",
+        params,
+        metrics,
+        {"pumped": pumped, "constant": constant},
+        ("pumped", "constant"),
+    )
+
+
+# ---------------------------------------------------------------- slope with spin
+
+
+def slope_spin(fidelity="balanced", reduced=False, progress=False):
+    """A ball bouncing on a 0.3 rad slope with back-spin, no spin and top-spin.
+
+    Ring R = 0.1 m, h = 2 mm, E = 10 MPa, p = 30 kPa, dropped from rest (centre 0.5 m above the
+    slope's point below it) with spin -30, 0, +30 rad/s (counter-clockwise positive; the slope
+    rises to the right, so downhill is -x and +30 rad/s is top-spin for the downhill motion);
+    friction 0.5, no damping. Measured after the first lift-off: the centre's velocity along the
+    slope (downhill positive) and off it, and the spin. Claim: friction at the contact trades
+    spin for downhill speed, so top-spin leaves faster downhill than back-spin, and the spin moves
+    toward rolling.
+    """
+    slope, mu = 0.3, 0.5
+    spins = (-30.0, 30.0) if reduced else (-30.0, 0.0, 30.0)
+    n = np.array([-math.sin(slope), math.cos(slope)])
+    downhill = -np.array([math.cos(slope), math.sin(slope)])
+    rows = []
+    trajectories = {}
+    for w in spins:
+        ring = Ring(
+            radius=0.1,
+            thickness=2e-3,
+            youngs_modulus=10e6,
+            pressure=30e3,
+            position=(0.0, 0.5),
+            angular_velocity=w,
+        )
+        scene = Scene(rings=[ring], grounds=[Ground(angle=slope, friction=mu)])
+        traj = _run(scene, 0.55, fidelity, progress, output_dt=1e-3)
+        lift = first_event(traj, "liftoff")
+        k = min(int(np.searchsorted(traj.t, lift)) + 2, len(traj.t) - 1)
+        u, spin = rigid_motion(traj.x[k, 0], traj.v[k, 0])
+        u0, spin0 = rigid_motion(traj.x[0, 0], traj.v[0, 0])
+        touch = first_event(traj, "touchdown")
+        j = max(int(np.searchsorted(traj.t, touch)) - 1, 0)
+        ui, _ = rigid_motion(traj.x[j, 0], traj.v[j, 0])
+        rows.append(
+            {
+                "spin_in_rad_per_s": spin0,
+                "downhill_in_m_per_s": float(ui @ downhill),
+                "normal_in_m_per_s": float(ui @ n),
+                "spin_out_rad_per_s": spin,
+                "downhill_out_m_per_s": float(u @ downhill),
+                "normal_out_m_per_s": float(u @ n),
+                "touchdown_s": touch,
+                "liftoff_s": lift,
+            }
+        )
+        trajectories[f"spin {w:+g} rad/s"] = traj
+    params = {"slope": slope, "friction": mu, "spins": list(spins), "radius": 0.1, "pressure": 30e3}
+    return SceneResult("slope-spin", params, {"cases": rows}, trajectories, tuple(trajectories))
+
+
+# ---------------------------------------------------------------- two balls
+
+
+def two_balls(fidelity="balanced", reduced=False, progress=False, speed=3.0, offset=0.05):
+    """Two balls collide in flight (no gravity, no ground).
+
+    Equal rings R = 0.1 m, h = 2 mm, E = 10 MPa, p = 30 kPa, centres 0.5 m apart along x and
+    ``offset`` (5 cm) apart along y, approaching at ``speed`` (3 m/s) each. Measured: total
+    momentum before and after (conserved by the equal and opposite collision impulses), the
+    normal restitution (relative x velocity after over before) and the spin the oblique contact
+    gives each ball.
+    """
+    kw = {"radius": 0.1, "thickness": 2e-3, "youngs_modulus": 10e6, "pressure": 30e3}
+    a = Ring(position=(-0.25, 0.0), velocity=(speed, 0.0), **kw)
+    b = Ring(position=(0.25, offset), velocity=(-speed, 0.0), **kw)
+    traj = _run(Scene(rings=[a, b], gravity=0.0), 0.25, fidelity, progress, output_dt=1e-3)
+    mass = total_mass(a)
+
+    def motion(k):
+        return [rigid_motion(traj.x[k, r], traj.v[k, r]) for r in range(2)]
+
+    before, after = motion(0), motion(-1)
+    p0 = mass * (before[0][0] + before[1][0])
+    p1 = mass * (after[0][0] + after[1][0])
+    rel0 = before[1][0][0] - before[0][0][0]
+    rel1 = after[1][0][0] - after[0][0][0]
+    gap = np.linalg.norm(traj.centre_of_mass()[:, 0] - traj.centre_of_mass()[:, 1], axis=1)
+    metrics = {
+        "momentum_before_N_s": p0.tolist(),
+        "momentum_after_N_s": p1.tolist(),
+        "momentum_change_relative": float(np.linalg.norm(p1 - p0) / (2 * mass * speed)),
+        "velocity_after_m_per_s": [after[0][0].tolist(), after[1][0].tolist()],
+        "spin_after_rad_per_s": [after[0][1], after[1][1]],
+        "restitution": float(-rel1 / rel0),
+        "closest_centre_distance_m": float(gap.min()),
+    }
+    params = {**kw, "width": 0.02, "density": 1100.0, "speed": speed, "offset": offset, "gravity": 0.0}
+    return SceneResult("two-balls", params, metrics, {"collision": traj}, ("collision",))

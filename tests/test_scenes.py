@@ -1,0 +1,105 @@
+"""Each scene in reduced form (fast preset, fewer cases) asserts the physical claim it illustrates."""
+
+import json
+
+import numpy as np
+import pytest
+
+from ballenv import scenes
+from ballenv.scenes.__main__ import main
+
+FAST = {"fidelity": "fast", "reduced": True}
+
+
+def test_unknown_scene_lists_the_names():
+    with pytest.raises(ValueError, match="unknown scene 'nope': the scenes are bounce-vs-pressure, "):
+        scenes.get("nope")
+
+
+def test_apex_rises_with_pressure_more_for_the_softer_wall():
+    res = scenes.run("bounce-vs-pressure", **FAST)
+    apex = res.metrics["apex_m"]
+    for label in ("10 MPa", "25 MPa"):
+        assert np.all(np.diff(apex[label]) > 0.0), apex
+    rise = res.metrics["apex_rise_m"]
+    assert rise["10 MPa"] > rise["25 MPa"] > 0.05
+
+
+def test_bounce_strip_frames_every_15_ms():
+    res = scenes.run("bounce-strip", **FAST)
+    m = res.metrics
+    times = np.array(m["frame_times_s"])
+    assert len(times) >= 6
+    np.testing.assert_allclose(np.diff(times), 0.015, atol=6e-4)
+    assert times[0] < m["touchdown_s"] < m["liftoff_s"] < times[-1]
+    assert 0.005 < m["contact_duration_s"] < 0.05 and m["max_compression"] > 0.05
+
+
+def test_tennis_ball_deforms_globally_basketball_locally():
+    res = scenes.run("deformation", **FAST)
+    basket, tennis = res.metrics["basketball"], res.metrics["tennis ball"]
+    assert basket["p_R3_over_EI"] > 1000.0 and tennis["p_R3_over_EI"] < 3.0
+    # the tennis ball: an oval, flattened top and sharper sides
+    assert tennis["aspect_change"] > 0.3
+    assert tennis["curvature_top"] < 0.6 and tennis["curvature_side_over_top"] > 2.0
+    # the basketball: a flat patch, the free wall still close to a circle, little aspect change
+    assert basket["patch_over_width"] > 0.1
+    assert basket["aspect_change"] < 0.15 and basket["aspect_change"] < tennis["aspect_change"] / 3
+    assert basket["curvature_top"] > 0.8 and basket["curvature_side_over_top"] < 1.4
+
+
+def test_rolling_height_grows_with_youngs_modulus():
+    res = scenes.run("rolling", **FAST)
+    heights = res.metrics["height_over_diameter"]
+    assert np.all(np.diff(heights) > 0.02), heights
+    assert heights[0] < 0.6 and heights[-1] > 0.75
+    assert all(s > 0.05 for s in res.metrics["rolling_speed_m_per_s"])  # they roll down
+
+
+def test_pumped_ball_bounces_higher_above_its_rest():
+    res = scenes.run("variable-inflation", **FAST)
+    m = res.metrics
+    assert len(m["switch_times_s"]) == len(m["schedule_Pa"]) - 1
+    pumped, constant = m["pumped_rise_above_rest_m"], m["constant_rise_above_rest_m"]
+    assert pumped[0] == pytest.approx(constant[0])  # the same ball until the first pump
+    assert all(p > c for p, c in zip(pumped[1:], constant[1:], strict=False)), (pumped, constant)
+    assert m["peak_pressure_Pa"] > 1.5 * max(m["schedule_Pa"])  # the gas law at impact
+
+
+def test_spin_on_a_slope_trades_for_downhill_speed():
+    res = scenes.run("slope-spin", **FAST)
+    back, top = res.metrics["cases"]
+    assert back["spin_in_rad_per_s"] < 0 < top["spin_in_rad_per_s"]
+    assert top["downhill_out_m_per_s"] > back["downhill_out_m_per_s"] + 1.0
+    for case in (back, top):
+        assert abs(case["spin_out_rad_per_s"]) < abs(case["spin_in_rad_per_s"])
+        assert case["normal_out_m_per_s"] > 0.5  # it bounced
+
+
+def test_two_balls_conserve_momentum_and_rebound():
+    res = scenes.run("two-balls", **FAST)
+    m = res.metrics
+    assert m["momentum_change_relative"] < 1e-9
+    assert 0.3 < m["restitution"] < 1.0
+    (va, vb) = m["velocity_after_m_per_s"]
+    assert va[0] < 0.0 < vb[0]
+    assert m["closest_centre_distance_m"] > 0.16  # no tunnelling
+
+
+def test_cli_writes_figure_video_numbers_and_trajectories(tmp_path, capsys):
+    assert (
+        main(["two-balls", "--out", str(tmp_path), "--fidelity", "fast", "--reduced", "--frames", "12"]) == 0
+    )
+    for name in ("two-balls.png", "two-balls.gif", "two-balls.json", "two-balls-collision.npz"):
+        assert (tmp_path / name).stat().st_size > 500, name
+    record = json.loads((tmp_path / "two-balls.json").read_text())
+    assert record["parameters"]["speed"] == 3.0 and record["metrics"]["restitution"] > 0.3
+    from PIL import Image
+
+    with Image.open(tmp_path / "two-balls.gif") as gif:
+        assert gif.n_frames == 12
+    assert main(["--list"]) == 0
+    assert "rolling" in capsys.readouterr().out
+    with pytest.raises(SystemExit):
+        main(["nope", "--out", str(tmp_path)])
+    assert "the scenes are" in capsys.readouterr().err

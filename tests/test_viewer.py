@@ -1,0 +1,97 @@
+"""The replay page: self-contained, and it plays in a real headless browser (Debian's chromium)."""
+
+import os
+import shutil
+import subprocess
+import tempfile
+
+import numpy as np
+import pytest
+
+from ballenv.physics import Ground, Ring, Scene, Trajectory, simulate
+from ballenv.viewer import main, select_frames, write_html
+
+CHROMIUM_FLAGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+]
+
+
+@pytest.fixture(scope="module")
+def saved(tmp_path_factory):
+    ring = Ring(n_nodes=24, pressure=20e3, position=(0.0, 0.4))
+    scene = Scene(rings=[ring], grounds=[Ground(friction=0.5)], adaptive=True, dt=1e-2, impulse_tol=5e-3)
+    traj = simulate(scene, 0.5, output_dt=5e-3)
+    return traj, traj.save(tmp_path_factory.mktemp("viewer") / "drop.npz")
+
+
+def chromium():
+    """The chromium binary; missing, the test fails under CI (make test installs it) and skips
+    elsewhere."""
+    exe = shutil.which("chromium") or shutil.which("chromium-browser")
+    if exe is None:
+        message = "chromium not found: `make test` installs Debian's chromium (apt-get install chromium)"
+        if os.environ.get("CI"):
+            pytest.fail(message)
+        pytest.skip(message)
+    return exe
+
+
+def run_chromium(*args):
+    with tempfile.TemporaryDirectory() as profile:
+        return subprocess.run(
+            [chromium(), *CHROMIUM_FLAGS, f"--user-data-dir={profile}", *args],
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
+
+
+def test_select_frames_keeps_ends_and_spreads_in_time():
+    t = np.concatenate([np.linspace(0, 0.1, 500), np.linspace(0.1001, 1.0, 20)])
+    idx = select_frames(t, 50)
+    assert idx[0] == 0 and idx[-1] == len(t) - 1 and len(idx) <= 52
+    assert np.all(np.diff(idx) > 0)
+
+
+def test_page_is_self_contained(saved, tmp_path):
+    _, path = saved
+    assert main([str(path), "-o", str(tmp_path / "replay.html")]) == 0
+    page = (tmp_path / "replay.html").read_text()
+    for needle in ("http://", "https://", "<link", " src="):
+        assert needle not in page, needle
+    assert 'id="scrub"' in page and 'id="speed"' in page and 'id="play"' in page
+
+
+def test_bad_trajectory_file_is_a_clear_error(tmp_path, capsys):
+    bad = tmp_path / "bad.npz"
+    bad.write_text("nope")
+    assert main([str(bad), "-o", str(tmp_path / "r.html")]) == 2
+    assert "not a .npz archive" in capsys.readouterr().err
+
+
+def test_page_plays_in_headless_chromium(saved, tmp_path):
+    traj, path = saved
+    page = write_html(Trajectory.load(path), tmp_path / "replay.html")
+    k = 40
+    dom = run_chromium("--virtual-time-budget=2000", "--dump-dom", f"{page.as_uri()}#frame={k}")
+    assert dom.returncode == 0, dom.stderr[-2000:]
+    assert f'data-frame="{k}"' in dom.stdout, dom.stdout[-2000:]
+    t_shown = float(dom.stdout.split('data-t="')[1].split('"')[0])
+    assert t_shown == pytest.approx(traj.t[k], abs=1e-6)
+    assert f"frame {k}/{len(traj.t) - 1}" in dom.stdout
+    shot = tmp_path / "shot.png"
+    res = run_chromium("--window-size=940,800", f"--screenshot={shot}", f"{page.as_uri()}#frame={k}")
+    assert res.returncode == 0 and shot.exists(), res.stderr[-2000:]
+    from PIL import Image
+
+    pixels = np.asarray(Image.open(shot).convert("RGB")).reshape(-1, 3).astype(int)
+    ring = np.all(np.abs(pixels - [200, 60, 40]) < 30, axis=1).sum()
+    ground = np.all(np.abs(pixels - [150, 150, 150]) < 8, axis=1).sum()
+    assert ring > 200 and ground > 10000, (ring, ground)
