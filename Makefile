@@ -17,7 +17,7 @@ $(STAMP): pyproject.toml constraints.txt
 venv: $(STAMP)
 
 train: $(STAMP)
-	$(PY) train.py --algo ppo --action-mode pressure --log-dir runs
+	$(PY) train.py --algo ppo --action-mode pressure --vec-env subproc --log-dir runs
 
 # Debian's chromium, for the replay viewer's browser test (tests/test_viewer.py, which fails under
 # CI without it); installed with apt-get when absent (as root, or through sudo). A failed install
