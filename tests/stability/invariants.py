@@ -16,6 +16,12 @@ from ballenv.physics.simulate import SimulationError
 
 GROUND_TOLERANCE = 1e-6  # m: deepest a node may be below a ground in an accepted state
 ENERGY_ROUND_OFF = 1e-9  # energy growth allowed, relative to the sum of |energy parts| at the start
+# Generalized-alpha is not energy-stable for nonlinear rings: its true energy oscillates with the
+# phase of the motion, and a freely spinning ring at large steps gains up to about 1 % (measured:
+# 0.9 % for N = 32 at 20 rad/s, dt = 6.7e-3 s, rho_inf = 0.9; backward Euler loses energy). The
+# stepper's guard only rejects steps that gain more than 1 % of the free energy at once. Random
+# scenes with generalized-alpha are held to this bound instead of round-off (see the README).
+GA_ENERGY_BOUND = 2e-2
 # documented SimulationError messages name the setting to change
 DOCUMENTED_ERRORS = ("Scene.dt_min", "Scene.impulse_tol")
 
@@ -50,8 +56,9 @@ class Audit:
         """The run reached t_end, or stopped with a SimulationError that names why and what to change."""
         return self.reached_end or any(name in self.error for name in DOCUMENTED_ERRORS)
 
-    def problems(self, energy=True):
-        """Human-readable list of violated invariants (empty: the run is stable)."""
+    def problems(self, energy_tol=ENERGY_ROUND_OFF):
+        """Human-readable list of violated invariants (empty: the run is stable); ``energy_tol``:
+        the largest relative energy growth accepted."""
         out = []
         if not self.finite:
             out.append("non-finite state")
@@ -59,7 +66,7 @@ class Audit:
             out.append(f"ground penetration {self.penetration:.3g} m")
         if self.intrusion > 0.0:
             out.append(f"ring intrusion {self.intrusion:.3g} m")
-        if energy and self.energy_growth > ENERGY_ROUND_OFF:
+        if self.energy_growth > energy_tol:
             out.append(f"energy growth {self.energy_growth:.3g} (relative)")
         if not self.documented:
             out.append(f"undocumented stop: {self.error!r}")
