@@ -157,7 +157,9 @@ def soak_episodes(count, seed, steps=250):
             obs, reward, terminated, truncated, info = env.step(np.array([a], dtype=np.float32))
             tally["env steps"] += 1
             x = env._batch.state.x[0]
-            tally["non-finite"] += not (np.all(np.isfinite(obs)) and math.isfinite(reward) and np.all(np.isfinite(x)))
+            tally["non-finite"] += not (
+                np.all(np.isfinite(obs)) and math.isfinite(reward) and np.all(np.isfinite(x))
+            )
             tally["out of bounds"] += not env.observation_space.contains(obs)
             tally["below ground"] += x[:, 1].min() < -GROUND_TOLERANCE
             if info["sim_failure"]:
@@ -191,9 +193,11 @@ def main():
         "",
         "## Random scenes",
         "",
-        "| cases | BE / GA | accepted steps | rejected steps | non-finite | tunnelling | energy growth (BE / GA) |",
+        "| cases | BE / GA | accepted steps | rejected steps | non-finite | tunnelling "
+        "| energy growth (BE / GA) |",
         "|---:|---:|---:|---:|---:|---:|---:|",
-        f"| {tally['cases']} | {tally['backward_euler']} / {tally['generalized_alpha']} | {tally['steps']:,} | "
+        f"| {tally['cases']} | {tally['backward_euler']} / {tally['generalized_alpha']} "
+        f"| {tally['steps']:,} | "
         f"{sum(rejected.values()):,} | {tally['non-finite']} | {tally['tunnelling']} | "
         f"{tally['energy growth backward_euler']} / {tally['energy growth generalized_alpha']} |",
         "",
@@ -211,10 +215,7 @@ def main():
         "",
         "| integrator | runs | median | 99 % | max |",
         "|---|---:|---:|---:|---:|",
-        *[
-            f"| {k} | {len(v)} | {q(v, 0.5)} | {q(v, 0.99)} | {q(v, 1.0)} |"
-            for k, v in growth.items()
-        ],
+        *[f"| {k} | {len(v)} | {q(v, 0.5)} | {q(v, 0.99)} | {q(v, 1.0)} |" for k, v in growth.items()],
         "",
     ]
     if worst:
@@ -239,7 +240,10 @@ def main():
         f"{sum(v for k, v in episodes.items() if k.startswith('sim failure'))} |",
         "",
         "Episode ends: "
-        + (", ".join(f"{k[7:]} {v}" for k, v in sorted(episodes.items()) if k.startswith("ended: ")) or "none")
+        + (
+            ", ".join(f"{k[7:]} {v}" for k, v in sorted(episodes.items()) if k.startswith("ended: "))
+            or "none"
+        )
         + ".",
         "",
     ]

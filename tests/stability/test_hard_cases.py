@@ -134,3 +134,19 @@ def test_ground_contact_on_both_sides_of_a_wedge_stays_out_of_both():
                           dt=1e-2, adaptive=True)  # fmt: skip
             result = audit(scene, 0.6)
             assert result.problems() == [] and result.reached_end, (contact, integrator, result)
+
+
+@pytest.mark.parametrize("integrator", INTEGRATORS)
+@pytest.mark.parametrize("contact", CONTACTS)
+def test_a_heavy_ring_sliding_in_at_speed_meets_the_impulse_tolerance(contact, integrator):
+    """Regression (found by the soak): the Coulomb friction on a node arriving while it slides is
+    about mu m |v_n| whatever the step, like the normal impulse that stops it; it was counted in the
+    contact impulse, so this scene (mu m v_n = 0.65 N s per node against impulse_tol = 5e-3 N s)
+    stopped with "contact impulse above impulse_tol at dt_min" at the first touchdown."""
+    ring = Ring(radius=0.1, n_nodes=32, youngs_modulus=1e8, thickness=1e-2, width=0.05, density=3000.0,
+                pressure=1e5, position=(0.0, 0.2), velocity=(10.0, -15.0))  # fmt: skip
+    scene = Scene(rings=[ring], grounds=[Ground(friction=1.5)], contact=contact, integrator=integrator,
+                  dt=1e-2, adaptive=True)  # fmt: skip
+    result = audit(scene, 0.1)
+    assert result.problems() == [] and result.reached_end, result
+    assert result.rejections["impulse"] > 0  # the step control did act
