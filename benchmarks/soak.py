@@ -28,6 +28,7 @@ import math  # noqa: E402
 import pathlib  # noqa: E402
 import sys  # noqa: E402
 import time  # noqa: E402
+import traceback  # noqa: E402
 from collections import Counter  # noqa: E402
 from dataclasses import replace  # noqa: E402
 
@@ -107,7 +108,8 @@ def soak_scenes(count, seed):
     ends = Counter()
     growth = {"backward_euler": [], "generalized_alpha": []}
     worst = []
-    for _ in tqdm(range(count), desc="scenes", unit="scene"):
+    crashes = []
+    for index in tqdm(range(count), desc="scenes", unit="scene"):
         scene, t_end = random_scene(rng)
         tally["cases"] += 1
         tally[scene.integrator] += 1
@@ -115,6 +117,9 @@ def soak_scenes(count, seed):
             result = audit(scene, t_end)
         except Exception as exc:  # anything but a documented SimulationError is a failure to report
             ends[f"crash: {type(exc).__name__}: {exc}"[:120]] += 1
+            where = traceback.format_exc().strip().splitlines()[-3:]
+            crashes.append((index, scene, t_end, where))
+            tqdm.write(f"crash in scene {index} (t_end {t_end}): {scene}\n" + "\n".join(where))
             continue
         tally["steps"] += result.steps
         rejected.update({k: result.rejections[k] for k in REASONS})
@@ -134,7 +139,7 @@ def soak_scenes(count, seed):
             key = next((v for k, v in FAILURE_KEYS.items() if k in result.error), None)
             ends[key if key and result.documented else f"undocumented: {result.error[:80]}"] += 1
     worst.sort(key=lambda w: -w[0])
-    return tally, rejected, ends, growth, worst
+    return tally, rejected, ends, growth, worst, crashes
 
 
 def soak_episodes(count, seed, steps=250):
@@ -177,7 +182,7 @@ def main():
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args()
     start = time.perf_counter()
-    tally, rejected, ends, growth, worst = soak_scenes(args.scenes, args.seed)
+    tally, rejected, ends, growth, worst, crashes = soak_scenes(args.scenes, args.seed)
     scene_time = time.perf_counter() - start
     episodes = soak_episodes(args.episodes, args.seed + 1)
     wall = time.perf_counter() - start
@@ -218,6 +223,8 @@ def main():
         *[f"| {k} | {len(v)} | {q(v, 0.5)} | {q(v, 0.99)} | {q(v, 1.0)} |" for k, v in growth.items()],
         "",
     ]
+    for index, scene, t_end, where in crashes:
+        lines += [f"Crash in scene {index} (t_end {t_end:.4g} s): `{scene}`", "", "```", *where, "```", ""]
     if worst:
         lines += ["Largest energy growths (scene, t_end):", ""]
         for g, scene, t_end in worst[:5]:
