@@ -6,7 +6,7 @@ PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 export OPENBLAS_NUM_THREADS := 1
 
-.PHONY: venv train browser demo scenes test test-slow bench lint format clean
+.PHONY: venv train browser demo scenes test test-slow bench soak lint format clean
 
 $(STAMP): pyproject.toml constraints.txt
 	$(PYTHON) -m venv $(VENV)
@@ -50,6 +50,9 @@ bench: $(STAMP)
 	$(PY) benchmarks/collision_cost.py
 	$(PY) benchmarks/work_precision.py
 	$(PY) benchmarks/env_throughput.py
+
+soak: $(STAMP)  # the stability soak (about 10 minutes), not part of test or bench
+	$(PY) benchmarks/soak.py
 
 lint: $(STAMP)
 	$(PY) -m ruff check .

@@ -200,6 +200,24 @@ def _range(owner, name, value, low, high, unit):
     return (lo, hi)
 
 
+def parse_actions(actions, count, what):
+    """``actions`` as a float64 array of ``count`` finite numbers (any array of that size of real
+    numbers: ints or floats, not bools, strings or complex), else ValueError naming ``what``."""
+    try:
+        a = np.asarray(actions)
+    except (TypeError, ValueError):  # ragged nesting
+        a = np.asarray(None)
+    if a.dtype.kind in "iuf" and a.size == count:
+        a = a.astype(np.float64).reshape(-1)
+        if np.all(np.isfinite(a)):
+            return a
+    shape = "(1,)" if count == 1 else f"({count}, 1)"
+    raise ValueError(
+        f"InflatedBall-v0 {what} = {actions!r} is invalid: must be {count} finite real number"
+        f"{'s' if count > 1 else ''} (shape {shape}; values outside [-1, 1] are clipped)"
+    )
+
+
 def draw_reset(config, rng):
     """Start values of one episode from ``rng``: centre (m), velocity (m/s), phase (rad), target (m)."""
     target = rng.uniform(*config.target_height_range)

@@ -5,7 +5,7 @@ from gymnasium import Env, spaces
 from gymnasium.utils import EzPickle
 
 from .batch import END_REASONS, REWARD_TERMS, BallBatch, observation_structure
-from .config import BallEnvConfig, draw_reset, failure_message
+from .config import BallEnvConfig, draw_reset, failure_message, parse_actions
 
 
 class InflatedBallEnv(Env, EzPickle):
@@ -149,11 +149,7 @@ class InflatedBallEnv(Env, EzPickle):
         return self._batch.obs[0].copy(), info
 
     def step(self, action):
-        a = np.asarray(action, dtype=np.float64).reshape(-1)
-        if a.shape != (1,) or not np.isfinite(a[0]):
-            raise ValueError(
-                f"InflatedBall-v0.step action = {action!r} is invalid: must be one finite number"
-            )
+        a = parse_actions(action, 1, "step action")
         self._actions[0] = min(1.0, max(-1.0, a[0]))
         batch = self._batch
         batch.step(self._actions)

@@ -14,7 +14,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 from .batch import END_FAILURE, END_REASONS, REWARD_TERMS, BallBatch, observation_structure
-from .config import BallEnvConfig, draw_reset, failure_message
+from .config import BallEnvConfig, draw_reset, failure_message, parse_actions
 from .inflated_ball import InflatedBallEnv
 
 DEFAULT_MAX_EPISODE_STEPS = 1000
@@ -94,12 +94,7 @@ class InflatedBallVectorEnv(VectorEnv):
         self._batch.reset(i, centre, velocity, phase, target, self.config.initial_pressure)
 
     def step(self, actions):
-        a = np.asarray(actions, dtype=np.float64).reshape(-1)
-        if a.shape != (self.num_envs,) or not np.all(np.isfinite(a)):
-            raise ValueError(
-                f"InflatedBall-v0 vector step actions of shape {np.shape(actions)} are invalid: must be "
-                f"{self.num_envs} finite numbers, shape ({self.num_envs}, 1)"
-            )
+        a = parse_actions(actions, self.num_envs, "vector step actions")
         np.clip(a, -1.0, 1.0, out=self._actions)
         resetting = self._autoreset.copy()
         batch = self._batch

@@ -32,13 +32,19 @@ def polygon_area(x):
 
 @njit(cache=True)
 def gas_pressure(area, gas_constant, gas_exponent, atmospheric_pressure):
-    """Gauge pressure (Pa) from the gas law ``(p + p_atm) A^k = C``; ``C`` in Pa m^(2k)."""
+    """Gauge pressure (Pa) from the gas law ``(p + p_atm) A^k = C``; ``C`` in Pa m^(2k). NaN for a
+    polygon turned inside out (``A <= 0``: no gas state; the Newton iterate is then taken back or
+    the step rejected)."""
+    if not area > 0.0:
+        return math.nan
     return gas_constant / area**gas_exponent - atmospheric_pressure
 
 
 @njit(cache=True)
 def gas_pressure_slope(area, gas_constant, gas_exponent):
-    """``dp/dA = -k (p + p_atm) / A`` (Pa/m^2)."""
+    """``dp/dA = -k (p + p_atm) / A`` (Pa/m^2); NaN for ``A <= 0``."""
+    if not area > 0.0:
+        return math.nan
     return -gas_exponent * gas_constant / area ** (gas_exponent + 1.0)
 
 
@@ -47,7 +53,10 @@ def gas_energy(area, gas_constant, gas_exponent, atmospheric_pressure, width):
     """Potential (J) of the gas, ``U = -b int (p + p_atm - p_atm) dA``; ``F = -dU/dx = b p dA/dx``.
 
     ``k = 1``: ``U = -b (C ln A - p_atm A)``; otherwise ``U = -b (C A^(1-k) / (1-k) - p_atm A)``.
+    NaN for ``A <= 0``.
     """
+    if not area > 0.0:
+        return math.nan
     if gas_exponent == 1.0:
         return -width * (gas_constant * math.log(area) - atmospheric_pressure * area)
     return -width * (

@@ -76,8 +76,8 @@ def check_sequence(owner, name, value, cls, allow_empty):
 
 
 def check_choice(owner, name, value, choices):
-    """Return ``value`` if it is one of ``choices``, else raise ValueError."""
-    if value not in choices:
+    """Return ``value`` if it is one of ``choices`` (strings), else raise ValueError."""
+    if not isinstance(value, str) or value not in choices:
         _fail(owner, name, value, "one of " + ", ".join(repr(c) for c in choices))
     return value
 

@@ -152,7 +152,16 @@ def initial_state(scene):
 
 
 def _check_state(name, value, shape):
-    arr = np.asarray(value, dtype=float)
+    try:
+        arr = np.asarray(value)
+    except (TypeError, ValueError):  # ragged nesting
+        arr = np.asarray(None)
+    if arr.dtype.kind not in "iuf":
+        raise ValueError(
+            f"simulate.{name} = {value!r} is invalid: must be an array of real numbers of shape {shape} "
+            "(m or m/s)"
+        )
+    arr = arr.astype(float)
     if arr.shape == shape[1:] and shape[0] == 1:
         arr = arr[None]
     if arr.shape != shape:

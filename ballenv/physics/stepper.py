@@ -409,7 +409,11 @@ def try_step(model, solver, state, trial, h, ws):
     reaction that stops the nodes arriving on a ground in this step (normal velocity ``v_n < 0`` and
     distance ``gap`` at the step's start). An arriving node loses its normal momentum in whatever
     step it arrives (a point mass hitting a rigid wall), so no step size could bring that part under
-    a tolerance; the remainder grows with ``h`` and is what the step-size control bounds. ``kappa`` is
+    a tolerance; the remainder grows with ``h`` and is what the step-size control bounds. The same
+    holds for the Coulomb friction on an arriving node while it is stopped, at most ``mu`` times that
+    normal impulse: the tangential impulse of an arriving node is counted only above
+    ``mu kappa m |v_n + gap / h|`` (without this, a sliding impact left a floor ``mu m v_n`` per arriving
+    node that no step size could bring under ``impulse_tol``). ``kappa`` is
     the integrator's reaction to an arrival per unit momentum: 1 for backward Euler,
     ``(1 - alpha_m) / beta`` for generalized-alpha (whose Newmark update reflects the node's normal
     velocity before :func:`_rest_on_grounds` removes it).
@@ -474,6 +478,11 @@ def try_step(model, solver, state, trial, h, ws):
                     vn = min(0.0, v0[r, i, 0] * nx + v0[r, i, 1] * ny + gap / h)
                     jx += m * vn * nx
                     jy += m * vn * ny
+                    # and the friction that comes with it, at most mu times that normal impulse
+                    jt = h * ft
+                    kept = math.copysign(max(0.0, abs(jt) - model.grounds[g, 3] * m * -vn), jt)
+                    jx += (jt - kept) * ny  # the tangent is (-n_y, n_x)
+                    jy -= (jt - kept) * nx
             impulse = max(impulse, math.sqrt(jx * jx + jy * jy))
     if model.collide and rings_intrude(trial.x, model.thickness, cw):
         return -REJECT_INTRUSION, 0.0

@@ -1,0 +1,264 @@
+"""Soak run of the stability suite (issue 8): thousands of random scenes and env episodes, seeded.
+
+    python benchmarks/soak.py [--scenes 2000] [--episodes 400] [--seed 0]
+    # prints the table, writes benchmarks/results/soak.md
+
+Scenes: drawn like ``tests/stability/test_random.py``'s valid scenes (the hard cases' ranges): one
+or two rings of radius 0.05-0.3 m, N 8-256, E 0.1 MPa-1 GPa (log-uniform), h/R 0.005-0.3, gauge
+pressure none or 0-40 % of the wall's bound (at most 10 bar), released 1 mm-0.5 m above a floor or a
+slope of up to 75 degrees (friction 0-2) at up to 30 m/s per component and 50 rad/s, gravity
+0-20 m/s^2, damping 0/5/50 1/s, either contact method and integrator, rho_inf 0-1, adaptive or
+fixed steps of 1e-4-1e-2 s, 0.02-0.15 s simulated. Each run is audited
+(``tests/stability/invariants.py``): non-finite states, tunnelling (a node more than 1e-6 m below a
+ground, or inside another ring), energy growth (total energy above its start value by more than
+1e-9 of the start's sum of |parts|), and how it ended (t_end, a documented SimulationError by
+reason, or anything else).
+
+Episodes: InflatedBall-v0 (fast preset), both action modes, 250 steps each (2.5 s) of uniform
+random, extreme (+1 / -1) or alternating-extreme actions, resets included: non-finite or
+out-of-bounds observations, nodes below the ground, simulator failures.
+"""
+
+import os
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import argparse  # noqa: E402
+import math  # noqa: E402
+import pathlib  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+import traceback  # noqa: E402
+from collections import Counter  # noqa: E402
+from dataclasses import replace  # noqa: E402
+
+import numpy as np  # noqa: E402
+from tqdm.auto import tqdm  # noqa: E402
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from ballenv.envs.inflated_ball import InflatedBallEnv  # noqa: E402
+from ballenv.physics import Ground, Ring, Scene  # noqa: E402
+from ballenv.physics.ring import inflated_radius  # noqa: E402
+from tests.stability.invariants import (  # noqa: E402
+    ENERGY_ROUND_OFF,
+    GROUND_TOLERANCE,
+    audit,
+)
+
+RESULTS = ROOT / "benchmarks" / "results"
+REASONS = ("newton", "energy", "intrusion", "self_intersection", "impulse")
+FAILURE_KEYS = {
+    "a ring's wall crossed itself": "dt_min: wall crossed itself",
+    "Newton's iteration did not converge": "dt_min: Newton did not converge",
+    "the step gained energy": "dt_min: step gained energy",
+    "a node of one ring ended inside another ring": "dt_min: ring intrusion",
+    "contact impulse per step stayed above": "impulse above impulse_tol at dt_min",
+}
+
+
+def log_uniform(rng, lo, hi):
+    return math.exp(rng.uniform(math.log(lo), math.log(hi)))
+
+
+def random_scene(rng):
+    """A random valid scene in the hard cases' ranges and its end time (see the module doc)."""
+    radius = rng.uniform(0.05, 0.3)
+    modulus = log_uniform(rng, 1e5, 1e9)
+    thickness = radius * log_uniform(rng, 0.005, 0.3)
+    burst = 0.5 * modulus * thickness / radius
+    pressure = None if rng.random() < 0.15 else rng.uniform(0.0, min(1e6, 0.4 * burst))
+    n_nodes = int(rng.choice([8, 16, 32, 64, 128, 256], p=[0.1, 0.25, 0.3, 0.2, 0.1, 0.05]))
+    angle = math.radians(rng.uniform(-75.0, 75.0) if rng.random() < 0.6 else 0.0)
+    normal = np.array([-math.sin(angle), math.cos(angle)])
+    tangent = np.array([normal[1], -normal[0]])
+    base = Ring(
+        radius=radius, n_nodes=n_nodes, youngs_modulus=modulus, thickness=thickness,
+        width=rng.uniform(0.005, 0.1), density=rng.uniform(100.0, 3000.0), pressure=pressure,
+    )  # fmt: skip
+    lift = inflated_radius(base) + rng.uniform(1e-3, 0.5)
+    rings = []
+    for k in range(1 if rng.random() < 0.75 else 2):
+        centre = lift * normal + 3.0 * lift * k * tangent
+        rings.append(
+            replace(base, position=tuple(centre), velocity=tuple(rng.uniform(-30.0, 30.0, 2)),
+                    angular_velocity=rng.uniform(-50.0, 50.0))
+        )  # fmt: skip
+    scene = Scene(
+        rings=rings,
+        grounds=[Ground(angle=angle, friction=rng.uniform(0.0, 2.0))],
+        contact=str(rng.choice(["mass_modification", "predictor_corrector"])),
+        integrator=str(rng.choice(["backward_euler", "generalized_alpha"])),
+        rho_infinity=rng.uniform(0.0, 1.0),
+        gravity=rng.uniform(0.0, 20.0),
+        damping=float(rng.choice([0.0, 5.0, 50.0])),
+        gas_exponent=float(rng.choice([1.0, 1.4])),
+        atmospheric_pressure=float(rng.choice([0.0, 101325.0])),
+        adaptive=bool(rng.random() < 0.7),
+        dt=log_uniform(rng, 1e-4, 1e-2),
+    )
+    return scene, rng.uniform(0.02, 0.15)
+
+
+def soak_scenes(count, seed):
+    rng = np.random.default_rng(seed)
+    tally = Counter()
+    rejected = Counter()
+    ends = Counter()
+    growth = {"backward_euler": [], "generalized_alpha": []}
+    worst = []
+    crashes = []
+    for index in tqdm(range(count), desc="scenes", unit="scene"):
+        scene, t_end = random_scene(rng)
+        tally["cases"] += 1
+        tally[scene.integrator] += 1
+        try:
+            result = audit(scene, t_end)
+        except Exception as exc:  # anything but a documented SimulationError is a failure to report
+            ends[f"crash: {type(exc).__name__}: {exc}"[:120]] += 1
+            where = traceback.format_exc().strip().splitlines()[-3:]
+            crashes.append((index, scene, t_end, where))
+            tqdm.write(f"crash in scene {index} (t_end {t_end}): {scene}\n" + "\n".join(where))
+            continue
+        tally["steps"] += result.steps
+        rejected.update({k: result.rejections[k] for k in REASONS})
+        tally["non-finite"] += not result.finite
+        tally["tunnelling"] += result.penetration > GROUND_TOLERANCE or result.intrusion > 0.0
+        tally["deepest"] = max(tally["deepest"], result.penetration)
+        grew = result.energy_growth > ENERGY_ROUND_OFF
+        tally["energy growth"] += grew
+        tally[f"energy growth {scene.integrator}"] += grew
+        if result.finite:
+            growth[scene.integrator].append(result.energy_growth)
+        if grew:
+            worst.append((result.energy_growth, scene, t_end))
+        if result.reached_end:
+            ends["reached t_end"] += 1
+        else:
+            key = next((v for k, v in FAILURE_KEYS.items() if k in result.error), None)
+            ends[key if key and result.documented else f"undocumented: {result.error[:80]}"] += 1
+    worst.sort(key=lambda w: -w[0])
+    return tally, rejected, ends, growth, worst, crashes
+
+
+def soak_episodes(count, seed, steps=250):
+    rng = np.random.default_rng(seed)
+    tally = Counter()
+    envs = {mode: InflatedBallEnv(action_mode=mode) for mode in ("pressure", "paddle")}
+    for k in tqdm(range(count), desc="episodes", unit="ep"):
+        mode = ("pressure", "paddle")[k % 2]
+        policy = ("uniform", "plus", "minus", "alternating")[(k // 2) % 4]
+        env = envs[mode]
+        env.reset(seed=int(rng.integers(2**31)))
+        tally["episodes"] += 1
+        for s in range(steps):
+            a = {
+                "uniform": rng.uniform(-1.0, 1.0),
+                "plus": 1.0,
+                "minus": -1.0,
+                "alternating": 1.0 if s % 2 else -1.0,
+            }[policy]
+            obs, reward, terminated, truncated, info = env.step(np.array([a], dtype=np.float32))
+            tally["env steps"] += 1
+            x = env._batch.state.x[0]
+            tally["non-finite"] += not (
+                np.all(np.isfinite(obs)) and math.isfinite(reward) and np.all(np.isfinite(x))
+            )
+            tally["out of bounds"] += not env.observation_space.contains(obs)
+            tally["below ground"] += x[:, 1].min() < -GROUND_TOLERANCE
+            if info["sim_failure"]:
+                tally[f"sim failure: {info['sim_failure_reason']}"] += 1
+            if terminated:
+                tally[f"ended: {info['termination']}"] += 1
+                env.reset()
+    return tally
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--scenes", type=int, default=2000)
+    parser.add_argument("--episodes", type=int, default=400)
+    parser.add_argument("--seed", type=int, default=0)
+    args = parser.parse_args()
+    start = time.perf_counter()
+    tally, rejected, ends, growth, worst, crashes = soak_scenes(args.scenes, args.seed)
+    scene_time = time.perf_counter() - start
+    episodes = soak_episodes(args.episodes, args.seed + 1)
+    wall = time.perf_counter() - start
+
+    def q(values, p):
+        return f"{np.quantile(values, p):.2g}" if values else "-"
+
+    lines = [
+        "# Soak run (`python benchmarks/soak.py`)",
+        "",
+        f"Seed {args.seed}; {args.scenes} random scenes and {args.episodes} env episodes; wall time "
+        f"{wall:.0f} s ({scene_time:.0f} s scenes), numba warm from the on-disk cache.",
+        "",
+        "## Random scenes",
+        "",
+        "| cases | BE / GA | accepted steps | rejected steps | non-finite | tunnelling "
+        "| energy growth (BE / GA) |",
+        "|---:|---:|---:|---:|---:|---:|---:|",
+        f"| {tally['cases']} | {tally['backward_euler']} / {tally['generalized_alpha']} "
+        f"| {tally['steps']:,} | "
+        f"{sum(rejected.values()):,} | {tally['non-finite']} | {tally['tunnelling']} | "
+        f"{tally['energy growth backward_euler']} / {tally['energy growth generalized_alpha']} |",
+        "",
+        "Rejected steps by reason: " + ", ".join(f"{k} {rejected[k]:,}" for k in REASONS) + ".",
+        "",
+        f"Deepest node below a ground in any accepted state: {tally['deepest']:.2g} m (tolerance "
+        f"{GROUND_TOLERANCE:g} m).",
+        "",
+        "| how the run ended | runs |",
+        "|---|---:|",
+        *[f"| {k} | {v} |" for k, v in ends.most_common()],
+        "",
+        "Energy growth, relative to the start's sum of |energy parts| (max of E(t) - E(0)); "
+        "quantiles over finite runs:",
+        "",
+        "| integrator | runs | median | 99 % | max |",
+        "|---|---:|---:|---:|---:|",
+        *[f"| {k} | {len(v)} | {q(v, 0.5)} | {q(v, 0.99)} | {q(v, 1.0)} |" for k, v in growth.items()],
+        "",
+    ]
+    for index, scene, t_end, where in crashes:
+        lines += [f"Crash in scene {index} (t_end {t_end:.4g} s): `{scene}`", "", "```", *where, "```", ""]
+    if worst:
+        lines += ["Largest energy growths (scene, t_end):", ""]
+        for g, scene, t_end in worst[:5]:
+            r = scene.rings[0]
+            lines.append(
+                f"* {g:.2g}: {scene.integrator}, rho_inf {scene.rho_infinity:.2f}, dt {scene.dt:.2g} s "
+                f"{'adaptive' if scene.adaptive else 'fixed'}, N {r.n_nodes}, E {r.youngs_modulus:.3g} Pa, "
+                f"h/R {r.thickness / r.radius:.3g}, p {r.pressure}, spin {r.angular_velocity:.1f} rad/s, "
+                f"v {tuple(round(c, 1) for c in r.velocity)} m/s, {len(scene.rings)} ring(s), "
+                f"damping {scene.damping:g}, t_end {t_end:.3f} s"
+            )
+        lines.append("")
+    lines += [
+        "## Env episodes (InflatedBall-v0, fast preset)",
+        "",
+        "| episodes | env steps | non-finite | out of bounds | below ground | simulator failures |",
+        "|---:|---:|---:|---:|---:|---:|",
+        f"| {episodes['episodes']} | {episodes['env steps']:,} | {episodes['non-finite']} | "
+        f"{episodes['out of bounds']} | {episodes['below ground']} | "
+        f"{sum(v for k, v in episodes.items() if k.startswith('sim failure'))} |",
+        "",
+        "Episode ends: "
+        + (
+            ", ".join(f"{k[7:]} {v}" for k, v in sorted(episodes.items()) if k.startswith("ended: "))
+            or "none"
+        )
+        + ".",
+        "",
+    ]
+    text = "\n".join(lines)
+    print(text)
+    RESULTS.mkdir(exist_ok=True)
+    (RESULTS / "soak.md").write_text(text)
+
+
+if __name__ == "__main__":
+    main()
