@@ -78,9 +78,7 @@ class ModelPolicy:
         algo = algo or _algo_of(path)
         cls = {"ppo": PPO, "sac": SAC}[algo]
         self.model = cls.load(path, device="cpu")
-        self.obs_rms = None
-        self.clip_obs = 10.0
-        self.epsilon = 1e-8
+        self.normalize = None  # the saved VecNormalize (its env detached), frozen
         stats = path.parent / (
             "best_vecnormalize.pkl" if path.name == "best_model.zip" else "vecnormalize.pkl"
         )
@@ -88,17 +86,15 @@ class ModelPolicy:
             with open(stats, "rb") as f:
                 normalize = pickle.load(f)
             if normalize.norm_obs:
-                self.obs_rms = normalize.obs_rms
-                self.clip_obs = normalize.clip_obs
-                self.epsilon = normalize.epsilon
+                normalize.training = False
+                self.normalize = normalize
 
     def reset(self, seed):
         pass
 
     def act(self, obs):
-        if self.obs_rms is not None:
-            scaled = (obs - self.obs_rms.mean) / np.sqrt(self.obs_rms.var + self.epsilon)
-            obs = np.clip(scaled, -self.clip_obs, self.clip_obs).astype(np.float32)
+        if self.normalize is not None:
+            obs = self.normalize.normalize_obs(obs).astype(np.float32)
         action, _ = self.model.predict(obs, deterministic=True)
         return np.asarray(action, dtype=np.float32).reshape(1)
 

@@ -177,6 +177,25 @@ def locate_point(px, py, poly):
 
 
 @njit(cache=True)
+def _record_contact(px, py, poly, a, i, b, reach, contacts, count):
+    """Locate node ``i`` of ring ``a`` at ``(px, py)`` against ring ``b``'s polygon ``poly``; if
+    its signed distance (m, negative inside) is below ``reach``, append the row
+    ``(a, i, b, j, t, signed)`` to ``contacts`` (while there is room). Returns the new count."""
+    inside, j, t, dist = locate_point(px, py, poly)
+    signed = -dist if inside else dist
+    if signed < reach and count < contacts.shape[0]:
+        row = contacts[count]
+        row[0] = a
+        row[1] = i
+        row[2] = b
+        row[3] = j
+        row[4] = t
+        row[5] = signed
+        count += 1
+    return count
+
+
+@njit(cache=True)
 def _pair_contacts(x, a, b, reach, box, contacts, count):
     """Contacts of the nodes of ring ``a`` within ``reach`` (m) of ring ``b``'s centreline."""
     poly = x[b]
@@ -186,17 +205,7 @@ def _pair_contacts(x, a, b, reach, box, contacts, count):
             continue
         if py < box[b, 1] - reach or py > box[b, 3] + reach:
             continue
-        inside, j, t, dist = locate_point(px, py, poly)
-        signed = -dist if inside else dist
-        if signed < reach and count < contacts.shape[0]:
-            row = contacts[count]
-            row[0] = a
-            row[1] = i
-            row[2] = b
-            row[3] = j
-            row[4] = t
-            row[5] = signed
-            count += 1
+        count = _record_contact(px, py, poly, a, i, b, reach, contacts, count)
     return count
 
 
@@ -233,17 +242,7 @@ def find_contacts_all_pairs(x, thickness, contacts):
                 continue
             reach = thickness[a] + thickness[b]
             for i in range(x.shape[1]):
-                inside, j, t, dist = locate_point(x[a, i, 0], x[a, i, 1], x[b])
-                signed = -dist if inside else dist
-                if signed < reach and count < contacts.shape[0]:
-                    row = contacts[count]
-                    row[0] = a
-                    row[1] = i
-                    row[2] = b
-                    row[3] = j
-                    row[4] = t
-                    row[5] = signed
-                    count += 1
+                count = _record_contact(x[a, i, 0], x[a, i, 1], x[b], a, i, b, reach, contacts, count)
     return count
 
 

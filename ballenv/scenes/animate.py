@@ -9,13 +9,11 @@ import math
 
 import numpy as np
 
+from ..render import BACKGROUND, FORCE, FORCE_SCALE, RING, TEXT
+
 PANEL = 320  # pixels, panel height
-BACKGROUND = (250, 250, 247)
-GROUND = (150, 150, 150)
-RINGS = ((200, 60, 40), (40, 90, 200), (40, 150, 70), (150, 60, 160))
-FORCE = (30, 110, 200)
-TEXT = (20, 20, 20)
-FORCE_SCALE = 0.002  # m of arrow per N
+GROUND = (150, 150, 150)  # lighter than the renderer's, the replay viewer's grey
+RINGS = (RING, (40, 90, 200), (40, 150, 70), (150, 60, 160))
 
 
 def _pil():

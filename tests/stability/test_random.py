@@ -217,38 +217,22 @@ def _assert_names_field(err, owner, field):
     assert "must" in message, message  # ... followed by the valid range or choices
 
 
-def _check(cls, owner, field, value):
-    with pytest.raises(ValueError) as err:
-        cls(**{field: value})
-    _assert_names_field(err, owner, field)
+@pytest.mark.parametrize(
+    ("cls", "field"),
+    [(Ring, f) for f in RING_FIELDS]
+    + [(Ground, f) for f in GROUND_FIELDS]
+    + [(Scene, f) for f in SCENE_FIELDS],
+    ids=lambda v: v.__name__ if isinstance(v, type) else v,
+)
+def test_invalid_ring_ground_and_scene_values_raise_naming_field_and_range(cls, field):
+    fields = {Ring: RING_FIELDS, Ground: GROUND_FIELDS, Scene: SCENE_FIELDS}[cls]
 
-
-@pytest.mark.parametrize("field", list(RING_FIELDS))
-def test_invalid_ring_values_raise_naming_field_and_range(field):
     @settings(max_examples=25, **SETTINGS)
-    @given(RING_FIELDS[field])
+    @given(fields[field])
     def run(value):
-        _check(Ring, "Ring", field, value)
-
-    run()
-
-
-@pytest.mark.parametrize("field", list(GROUND_FIELDS))
-def test_invalid_ground_values_raise_naming_field_and_range(field):
-    @settings(max_examples=25, **SETTINGS)
-    @given(GROUND_FIELDS[field])
-    def run(value):
-        _check(Ground, "Ground", field, value)
-
-    run()
-
-
-@pytest.mark.parametrize("field", list(SCENE_FIELDS))
-def test_invalid_scene_values_raise_naming_field_and_range(field):
-    @settings(max_examples=25, **SETTINGS)
-    @given(SCENE_FIELDS[field])
-    def run(value):
-        _check(Scene, "Scene", field, value)
+        with pytest.raises(ValueError) as err:
+            cls(**{field: value})
+        _assert_names_field(err, cls.__name__, field)
 
     run()
 
