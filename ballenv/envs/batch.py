@@ -35,6 +35,9 @@ from ..physics.stepper import (
     CLOCK_T,
     COUNT_EVENTS,
     COUNT_RECORDS,
+    ENERGY_BUDGET,
+    ENERGY_TOTAL,
+    N_CLOCK,
     N_COUNTERS,
     STATUS_BUFFER_FULL,
     STATUS_DONE,
@@ -156,6 +159,7 @@ def reset_env(
         set_rest_pressure(me, 0, pressure, x, v, se.a[0], se.active[0], se.energy[0], ws)
     else:
         restart(me, 0, x, v, se.a[0], se.active[0], se.energy[0], ws)
+    se.energy[0, ENERGY_BUDGET] = se.energy[0, ENERGY_TOTAL]  # a new episode starts a new budget
     clocks[e, CLOCK_T] = 0.0
     clocks[e, CLOCK_H] = solver.dt
     counters[e, :] = 0
@@ -391,7 +395,7 @@ class BallBatch:
         self.ws = build_workspace(self.n_nodes)
         self.state = empty_state(n_envs, self.n_nodes)
         self.trial = empty_state(n_envs, self.n_nodes)
-        self.clocks = np.zeros((n_envs, 2))
+        self.clocks = np.zeros((n_envs, N_CLOCK))
         self.counters = np.zeros((n_envs, N_COUNTERS), dtype=np.int64)
         shape = (n_envs, 1, 1, self.n_nodes, 2)
         self.records = Recording(

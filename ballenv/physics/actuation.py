@@ -2,7 +2,8 @@
 
 Both change a ring's energy on purpose, so each recomputes what the stepper carries for the ring
 (its energy and free energy for the energy guard, which then compares only steps without
-actuation, and the generalized-alpha start acceleration ``a = F / m``, as at a restart).
+actuation; its energy budget, raised or lowered by the change; and the generalized-alpha start
+acceleration ``a = F / m``, as at a restart).
 
 * :func:`set_rest_pressure`: the gas is set to the amount whose gauge pressure on the ring's inflated
   circle at rest is ``p`` (Pa), i.e. ``(p + p_atm) A_r^k`` with ``A_r`` the area of that circle
@@ -20,7 +21,7 @@ from .contact import FREE
 from .energy import ENERGY_GRAVITY, ring_energy
 from .loads import polygon_area
 from .ring import inflation_ratio_of
-from .stepper import free_energy, ring_force
+from .stepper import ENERGY_BUDGET, ENERGY_TOTAL, free_energy, ring_force
 
 
 @njit(cache=True)
@@ -69,9 +70,12 @@ def apply_impulse(model, r, x, v, a, active, energy, ws, nodes, count, jx, jy):
 
 @njit(cache=True)
 def restart(model, r, x, v, a, active, energy, ws):
-    """Recompute ring ``r``'s carried energy and start acceleration ``a = F / m`` (normal part zeroed
-    on ground-constrained nodes, which rest on the surface) after an actuation."""
+    """Recompute ring ``r``'s carried energy (3,) and start acceleration ``a = F / m`` (normal part
+    zeroed on ground-constrained nodes, which rest on the surface) after an actuation; the change
+    of energy is added to the ring's energy budget."""
+    before = energy[ENERGY_TOTAL]
     free_energy(model, r, x, v, ws.energy, energy)
+    energy[ENERGY_BUDGET] += energy[ENERGY_TOTAL] - before
     ring_force(model, r, x, v, ws.force)
     m = model.node_mass[r]
     for i in range(x.shape[0]):

@@ -4,6 +4,8 @@ Used by ``Trajectory.energy()`` and by the stepper's energy guard; ``Model.rest_
 value of the same sum (without gravity) on the ring's inflated circle at rest.
 """
 
+import math
+
 from numba import njit
 
 from .elastic import bend_energy, stretch_energy
@@ -36,3 +38,35 @@ def ring_energy(model, r, x, v, parts):
         )  # fmt: skip
     parts[ENERGY_GRAVITY] = gravity_energy(x, m, model.gravity) if model.use_gravity else 0.0
     return parts.sum()
+
+
+@njit(cache=True)
+def remove_internal_kinetic_energy(v, m, excess):
+    """Lower the kinetic energy of a ring (node velocities ``v`` (N, 2) m/s, equal node masses ``m``
+    kg) by ``excess`` (J) without changing its momentum: the velocities relative to the mean ``V``
+    are scaled, ``v_i <- V + s (v_i - V)`` with ``s = sqrt(1 - excess / K_int)`` and
+    ``K_int = m/2 sum |v_i - V|^2`` the kinetic energy of spin and deformation. This is the
+    smallest change of ``v`` (in the mass norm) that removes ``excess`` and keeps the momentum; it
+    lowers the angular momentum about the centre of mass by the factor ``s`` (a velocity
+    post-process like Su, Sheth & Fedkiw's energy clamp, IEEE TVCG 2013). Returns False, leaving
+    ``v`` untouched, if ``K_int <= excess``.
+    """
+    n = v.shape[0]
+    vx = 0.0
+    vy = 0.0
+    for i in range(n):
+        vx += v[i, 0]
+        vy += v[i, 1]
+    vx /= n
+    vy /= n
+    internal = 0.0
+    for i in range(n):
+        internal += (v[i, 0] - vx) ** 2 + (v[i, 1] - vy) ** 2
+    internal *= 0.5 * m
+    if not internal > excess:
+        return False
+    keep = math.sqrt(1.0 - excess / internal)
+    for i in range(n):
+        v[i, 0] = vx + keep * (v[i, 0] - vx)
+        v[i, 1] = vy + keep * (v[i, 1] - vy)
+    return True

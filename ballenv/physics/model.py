@@ -96,6 +96,7 @@ class Workspace(NamedTuple):
     reaction: np.ndarray  # (N,) normal ground reaction of the last solve (N)
     friction: np.ndarray  # (N,) friction force along the ground's tangent (N)
     energy: np.ndarray  # (5,) energy parts (J)
+    projection: np.ndarray  # (2,) rings whose energy gain the last trial step removed, and the J removed
     collision: CollisionWorkspace
 
 
@@ -105,7 +106,7 @@ class State(NamedTuple):
     a: np.ndarray  # (R, N, 2) m/s^2 (the generalized-alpha acceleration)
     active: np.ndarray  # (R, N) int64: constraining ground of each node, or -1
     contact_force: np.ndarray  # (R, N, 2) N
-    energy: np.ndarray  # (R, 2) J: each ring's energy and its free part (stepper.free_energy)
+    energy: np.ndarray  # (R, 3) J: each ring's energy, its free part and its budget (stepper.ENERGY_*)
 
 
 class Recording(NamedTuple):
@@ -247,6 +248,7 @@ def build_workspace(n_nodes, n_rings=1):
         reaction=np.zeros(n_nodes),
         friction=np.zeros(n_nodes),
         energy=np.zeros(5),
+        projection=np.zeros(2),
         collision=build_collision_workspace(n_rings, n_nodes),
     )
 
@@ -276,7 +278,7 @@ def empty_state(n_rings, n_nodes):
         a=np.zeros(shape),
         active=np.full((n_rings, n_nodes), -1, dtype=np.int64),
         contact_force=np.zeros(shape),
-        energy=np.zeros((n_rings, 2)),
+        energy=np.zeros((n_rings, 3)),
     )
 
 

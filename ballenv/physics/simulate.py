@@ -18,8 +18,10 @@ from .model import (
 )
 from .scene import Scene, check_real
 from .stepper import (
+    CLOCK_ENERGY_REMOVED,
     CLOCK_H,
     COUNT_BY_REASON,
+    COUNT_ENERGY_PROJECTED,
     COUNT_EVENTS,
     COUNT_IMPULSE_REJECTED,
     COUNT_NEWTON,
@@ -57,7 +59,11 @@ class SimulationError(RuntimeError):
 class SimulationStats:
     """Cost of a run: accepted and rejected steps, Newton iterations (linear solves), wall time (s);
     ``rejections`` counts the rejected steps by reason ("newton", "energy", "intrusion",
-    "self_intersection", "impulse": the adaptive step's contact impulse above ``impulse_tol``)."""
+    "self_intersection", "impulse": the adaptive step's contact impulse above ``impulse_tol``);
+    ``energy_projected``: accepted (step, ring) pairs whose energy rose above the ring's budget (its
+    start energy plus the work of actuation and collisions) by a small step error, removed from the
+    ring's velocities relative to its centre of mass; ``energy_removed`` (J): the sum of those
+    excesses (``stepper._within_energy_budget``)."""
 
     steps: int
     rejected_steps: int
@@ -66,6 +72,8 @@ class SimulationStats:
     effects: tuple
     integrator: str
     rejections: dict = field(default_factory=dict)  # rejected steps by reason (see REJECTION_REASONS)
+    energy_projected: int = 0
+    energy_removed: float = 0.0
 
 
 @dataclass
@@ -206,7 +214,7 @@ def simulate(scene, t_end, x0=None, v0=None, output_dt=None, progress=False):
         _check_apart(model, state.x, ws)
     initial_state_values(model, solver, state, ws)
     trial = empty_state(n_rings, n_nodes)
-    clock = np.array([0.0, solver.dt])
+    clock = np.array([0.0, solver.dt, 0.0])  # see stepper.CLOCK_*
     counters = np.zeros(N_COUNTERS, dtype=np.int64)
 
     capacity = 1 + (int(np.ceil(t_end / output_dt)) + 1 if output_dt else 1024)
@@ -260,6 +268,8 @@ def simulate(scene, t_end, x0=None, v0=None, output_dt=None, progress=False):
             "self_intersection": int(counters[COUNT_BY_REASON + REJECT_SELF_INTERSECTION - 1]),
             "impulse": int(counters[COUNT_IMPULSE_REJECTED]),
         },
+        energy_projected=int(counters[COUNT_ENERGY_PROJECTED]),
+        energy_removed=float(clock[CLOCK_ENERGY_REMOVED]),
     )
     n_out = int(counters[COUNT_RECORDS])
     n_ev = int(counters[COUNT_EVENTS])

@@ -32,7 +32,7 @@ from numba import njit
 from .collision import collision_impulses, collision_step_limit, rings_intrude, self_intersects
 from .contact import FREE, constrain_jacobian, constrain_residual, deepest_ground
 from .elastic import bend_force, bend_jacobian, stretch_force, stretch_jacobian
-from .energy import ENERGY_GRAVITY, ring_energy
+from .energy import ENERGY_GRAVITY, remove_internal_kinetic_energy, ring_energy
 from .events import detect_events
 from .linalg import solve_band_low_rank
 from .loads import (
@@ -63,7 +63,8 @@ COUNT_EVENTS = 5
 COUNT_REJECTION = 6  # why the last step was rejected: one of the REJECT_ codes
 COUNT_BY_REASON = 7  # counters[COUNT_BY_REASON + code - 1]: rejected steps by REJECT_ code
 COUNT_IMPULSE_REJECTED = 11  # adaptive steps rejected for a contact impulse above impulse_tol
-N_COUNTERS = 12
+COUNT_ENERGY_PROJECTED = 12  # accepted (step, ring) pairs whose energy gain was removed
+N_COUNTERS = 13
 
 # why a trial step was rejected (try_step returns minus the code)
 REJECT_NEWTON = 1  # Newton's iteration failed (non-finite, singular, too many corrections)
@@ -82,9 +83,17 @@ MAX_CONTACT_SET_CHANGES = 64
 ENERGY_GROWTH_TOL = 1e-2  # largest energy gain of a step, relative to the ring's free energy
 MIN_NEWTON_FRACTION = 1.0 / 32.0  # backtracking halves a correction at most 5 times
 
-# clock: time (s), current step size (s)
+# columns of State.energy (J): a ring's energy, its free part (see free_energy) and its energy
+# budget: the energy at the start plus what actuation and collision impulses gave it since
+ENERGY_TOTAL = 0
+ENERGY_FREE = 1
+ENERGY_BUDGET = 2
+
+# clock: time (s), current step size (s), energy removed by the energy budget so far (J)
 CLOCK_T = 0
 CLOCK_H = 1
+CLOCK_ENERGY_REMOVED = 2
+N_CLOCK = 3
 
 
 @njit(cache=True)
@@ -123,14 +132,46 @@ def free_energy(model, r, x, v, parts, out):
 def _energy_grew(total_before, free_before, total_after, free_after):
     """True if a step from energy ``total_before`` to ``total_after`` (J; ``free_``: their free
     parts, see :func:`free_energy`) raised the total by more than ``ENERGY_GROWTH_TOL`` times the
-    mean free energy. Nothing in a scene without actuation adds energy: the gas and gravity are
-    potentials; damping, friction and the ground's constraints only remove it. Far too large
-    implicit steps of a nonlinear ring can converge to such spurious solutions; they are rejected
-    and retried smaller."""
+    mean free energy, or gave a non-finite energy."""
     if not math.isfinite(total_after):
         return True
     free = max(0.5 * (free_before + free_after), 0.0)
     return total_after - total_before > ENERGY_GROWTH_TOL * free + 1e-12 * abs(total_before)
+
+
+@njit(cache=True)
+def _within_energy_budget(model, r, before, kick, trial, ws):
+    """Hold ring ``r``'s energy after a trial step to its budget ``trial.energy[r, ENERGY_BUDGET]``
+    (J): its energy at the start of the run plus what actuation and collision impulses gave it
+    since. Nothing else in a scene adds energy: the gas and gravity are potentials; damping,
+    friction and the ground's constraints only remove it. ``before`` is the ring's carried energy
+    row before the step, ``kick`` the kinetic energy the step's collision impulses gave it.
+
+    A gain of the step above ``ENERGY_GROWTH_TOL`` times the mean free energy is a spurious solution
+    (far too large implicit steps of a nonlinear ring converge to some): returns False, the step is
+    rejected and retried smaller. Smaller gains are the integrator's truncation error
+    (generalized-alpha is not energy-stable for a nonlinear ring: the energy of a spinning ring
+    oscillates by about ``h^2.5``); whatever of it lifts the energy above the budget is removed from
+    the ring's velocities relative to its centre of mass, keeping its momentum
+    (:func:`energy.remove_internal_kinetic_energy`), ``trial.energy[r]`` is recomputed and the
+    removal is tallied in ``ws.projection`` (count, J). Returns False as well if the ring's spin and
+    deformation hold less kinetic energy than that excess (and the excess is above round-off,
+    1e-12 of the budget)."""
+    after = trial.energy[r]
+    if _energy_grew(
+        before[ENERGY_TOTAL] + kick, before[ENERGY_FREE] + kick, after[ENERGY_TOTAL], after[ENERGY_FREE]
+    ):
+        return False
+    budget = after[ENERGY_BUDGET]
+    excess = after[ENERGY_TOTAL] - budget
+    if excess <= 0.0:
+        return True
+    if not remove_internal_kinetic_energy(trial.v[r], model.node_mass[r], excess):
+        return excess <= 1e-12 * abs(budget)
+    free_energy(model, r, trial.x[r], trial.v[r], ws.energy, after)
+    ws.projection[0] += 1.0
+    ws.projection[1] += excess
+    return True
 
 
 @njit(cache=True)
@@ -376,10 +417,11 @@ def newton_ring(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active):
 
 @njit(cache=True)
 def initial_state_values(model, solver, state, ws):
-    """Fill what the stepper carries besides ``x, v``: every ring's energy and, for
-    generalized-alpha, its start acceleration."""
+    """Fill what the stepper carries besides ``x, v``: every ring's energy (its budget = its energy
+    now) and, for generalized-alpha, its start acceleration."""
     for r in range(state.x.shape[0]):
         free_energy(model, r, state.x[r], state.v[r], ws.energy, state.energy[r])
+        state.energy[r, ENERGY_BUDGET] = state.energy[r, ENERGY_TOTAL]
     if solver.method != METHOD_BACKWARD_EULER:
         initial_acceleration(model, state.x, state.v, state.a, ws)
 
@@ -400,8 +442,9 @@ def try_step(model, solver, state, trial, h, ws):
 
     Returns (Newton corrections, contact impulse in N s), or (-code, 0) if the step must be rejected,
     with ``code`` one of the ``REJECT_`` reasons: a ring's Newton iteration failed, a ring gained
-    energy, a ring crossed itself (``model.reject_self_intersection``), or a node of one ring ended
-    inside another (``model.collide``).
+    energy beyond what :func:`_within_energy_budget` removes, a ring crossed itself
+    (``model.reject_self_intersection``), or a node of one ring ended inside another
+    (``model.collide``).
 
     The contact impulse is the largest over rings of
     ``|h sum_i f_i + kappa sum_(i arriving) m min(0, v_n,i + gap_i / h) n|``: the ring's total ground
@@ -425,6 +468,7 @@ def try_step(model, solver, state, trial, h, ws):
     """
     total = 0
     impulse = 0.0
+    ws.projection[:] = 0.0
     contact = model.contact_method != CONTACT_NONE
     cw = ws.collision
     v0 = state.v
@@ -447,9 +491,8 @@ def try_step(model, solver, state, trial, h, ws):
             return -REJECT_SELF_INTERSECTION, 0.0
         free_energy(model, r, trial.x[r], trial.v[r], ws.energy, trial.energy[r])
         kick = cw.kinetic_change[r] if kicks else 0.0
-        if _energy_grew(
-            state.energy[r, 0] + kick, state.energy[r, 1] + kick, trial.energy[r, 0], trial.energy[r, 1]
-        ):
+        trial.energy[r, ENERGY_BUDGET] = state.energy[r, ENERGY_BUDGET] + kick
+        if not _within_energy_budget(model, r, state.energy[r], kick, trial, ws):
             return -REJECT_ENERGY, 0.0
         total += its
         if contact:
@@ -573,6 +616,8 @@ def advance(model, solver, ws, state, trial, clock, counters, t_pause, t_end, ou
             clock[CLOCK_H] = max(solver.dt_min, h * max(0.2, 0.9 * ratio))
             continue
         counters[COUNT_STEPS] += 1
+        counters[COUNT_ENERGY_PROJECTED] += int(ws.projection[0])
+        clock[CLOCK_ENERGY_REMOVED] += ws.projection[1]
         counters[COUNT_EVENTS] = detect_events(model, state, trial, t, h, rec.events, counters[COUNT_EVENTS])
         _accept(state, trial)
         clock[CLOCK_T] = stop

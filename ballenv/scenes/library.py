@@ -306,6 +306,8 @@ def _concatenate(parts, scene):
         effects=s[0].effects,
         integrator=s[0].integrator,
         rejections={k: sum(x.rejections.get(k, 0) for x in s) for k in s[0].rejections},
+        energy_projected=sum(x.energy_projected for x in s),
+        energy_removed=sum(x.energy_removed for x in s),
     )
     return Trajectory(
         t=np.concatenate([p.t for p in parts]),

@@ -16,12 +16,6 @@ from ballenv.physics.simulate import SimulationError
 
 GROUND_TOLERANCE = 1e-6  # m: deepest a node may be below a ground in an accepted state
 ENERGY_ROUND_OFF = 1e-9  # energy growth allowed, relative to the sum of |energy parts| at the start
-# Generalized-alpha is not energy-stable for nonlinear rings: its true energy oscillates with the
-# phase of the motion, and a freely spinning ring at large steps gains up to about 1 % (measured:
-# 0.9 % for N = 32 at 20 rad/s, dt = 6.7e-3 s, rho_inf = 0.9; backward Euler loses energy). The
-# stepper's guard only rejects steps that gain more than 1 % of the free energy at once. Random
-# scenes with generalized-alpha are held to this bound instead of round-off (see the README).
-GA_ENERGY_BOUND = 2e-2
 # documented SimulationError messages name the setting to change
 DOCUMENTED_ERRORS = ("Scene.dt_min", "Scene.impulse_tol")
 
