@@ -96,7 +96,7 @@ class Workspace(NamedTuple):
     reaction: np.ndarray  # (N,) normal ground reaction of the last solve (N)
     friction: np.ndarray  # (N,) friction force along the ground's tangent (N)
     energy: np.ndarray  # (5,) energy parts (J)
-    projection: np.ndarray  # (2,) rings whose energy gain the last trial step removed, and the J removed
+    energy_tally: np.ndarray  # (3,) what the last trial step's energy budget saw (stepper.TALLY_*)
     collision: CollisionWorkspace
 
 
@@ -248,7 +248,7 @@ def build_workspace(n_nodes, n_rings=1):
         reaction=np.zeros(n_nodes),
         friction=np.zeros(n_nodes),
         energy=np.zeros(5),
-        projection=np.zeros(2),
+        energy_tally=np.zeros(3),
         collision=build_collision_workspace(n_rings, n_nodes),
     )
 

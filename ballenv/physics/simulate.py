@@ -18,6 +18,7 @@ from .model import (
 )
 from .scene import Scene, check_real
 from .stepper import (
+    CLOCK_COLLISION_GAIN,
     CLOCK_ENERGY_REMOVED,
     CLOCK_H,
     COUNT_BY_REASON,
@@ -63,7 +64,10 @@ class SimulationStats:
     ``energy_projected``: accepted (step, ring) pairs whose energy rose above the ring's budget (its
     start energy plus the work of actuation and collisions) by a small step error, removed from the
     ring's velocities relative to its centre of mass; ``energy_removed`` (J): the sum of those
-    excesses (``stepper._within_energy_budget``)."""
+    excesses (``stepper._within_energy_budget``); ``collision_gain`` (J): the energy ring-ring and
+    self-contact impulses created by pushing out nodes that started a step inside the contact
+    distance, summed over the steps where their net effect was a gain (the one source of energy
+    besides actuation)."""
 
     steps: int
     rejected_steps: int
@@ -74,6 +78,7 @@ class SimulationStats:
     rejections: dict = field(default_factory=dict)  # rejected steps by reason (see REJECTION_REASONS)
     energy_projected: int = 0
     energy_removed: float = 0.0
+    collision_gain: float = 0.0
 
 
 @dataclass
@@ -214,7 +219,7 @@ def simulate(scene, t_end, x0=None, v0=None, output_dt=None, progress=False):
         _check_apart(model, state.x, ws)
     initial_state_values(model, solver, state, ws)
     trial = empty_state(n_rings, n_nodes)
-    clock = np.array([0.0, solver.dt, 0.0])  # see stepper.CLOCK_*
+    clock = np.array([0.0, solver.dt, 0.0, 0.0])  # see stepper.CLOCK_*
     counters = np.zeros(N_COUNTERS, dtype=np.int64)
 
     capacity = 1 + (int(np.ceil(t_end / output_dt)) + 1 if output_dt else 1024)
@@ -270,6 +275,7 @@ def simulate(scene, t_end, x0=None, v0=None, output_dt=None, progress=False):
         },
         energy_projected=int(counters[COUNT_ENERGY_PROJECTED]),
         energy_removed=float(clock[CLOCK_ENERGY_REMOVED]),
+        collision_gain=float(clock[CLOCK_COLLISION_GAIN]),
     )
     n_out = int(counters[COUNT_RECORDS])
     n_ev = int(counters[COUNT_EVENTS])

@@ -89,11 +89,19 @@ ENERGY_TOTAL = 0
 ENERGY_FREE = 1
 ENERGY_BUDGET = 2
 
-# clock: time (s), current step size (s), energy removed by the energy budget so far (J)
+# clock: time (s), current step size (s), energy removed by the energy budget so far (J), energy
+# collision impulses created so far (J)
 CLOCK_T = 0
 CLOCK_H = 1
 CLOCK_ENERGY_REMOVED = 2
-N_CLOCK = 3
+CLOCK_COLLISION_GAIN = 3
+N_CLOCK = 4
+
+# Workspace.energy_tally of a trial step: rings whose energy the budget lowered, the energy it
+# removed (J), the net energy the step's collision impulses created (J; 0 if they removed energy)
+TALLY_PROJECTED = 0
+TALLY_REMOVED = 1
+TALLY_COLLISION_GAIN = 2
 
 
 @njit(cache=True)
@@ -154,7 +162,7 @@ def _within_energy_budget(model, r, before, kick, trial, ws):
     oscillates by about ``h^2.5``); whatever of it lifts the energy above the budget is removed from
     the ring's velocities relative to its centre of mass, keeping its momentum
     (:func:`energy.remove_internal_kinetic_energy`), ``trial.energy[r]`` is recomputed and the
-    removal is tallied in ``ws.projection`` (count, J). Returns False as well if the ring's spin and
+    removal is tallied in ``ws.energy_tally``. Returns False as well if the ring's spin and
     deformation hold less kinetic energy than that excess (and the excess is above round-off,
     1e-12 of the budget)."""
     after = trial.energy[r]
@@ -169,8 +177,8 @@ def _within_energy_budget(model, r, before, kick, trial, ws):
     if not remove_internal_kinetic_energy(trial.v[r], model.node_mass[r], excess):
         return excess <= 1e-12 * abs(budget)
     free_energy(model, r, trial.x[r], trial.v[r], ws.energy, after)
-    ws.projection[0] += 1.0
-    ws.projection[1] += excess
+    ws.energy_tally[TALLY_PROJECTED] += 1.0
+    ws.energy_tally[TALLY_REMOVED] += excess
     return True
 
 
@@ -447,11 +455,12 @@ def try_step(model, solver, state, trial, h, ws):
     (``model.collide``).
 
     The contact impulse is the largest over rings of
-    ``|h sum_i f_i + kappa sum_(i arriving) m min(0, v_n,i + gap_i / h) n|``: the ring's total ground
-    reaction impulse over the step (its momentum change by contact, the paper's ``f dt``) less the
-    reaction that stops the nodes arriving on a ground in this step (normal velocity ``v_n < 0`` and
-    distance ``gap`` at the step's start). An arriving node loses its normal momentum in whatever
-    step it arrives (a point mass hitting a rigid wall), so no step size could bring that part under
+    ``|h sum_i f_i + kappa sum_i m min(0, v_n,i + gap_i / h) n|``: the ring's total ground reaction
+    impulse over the step (its momentum change by contact, the paper's ``f dt``) less the reaction
+    that stops the constrained nodes' start velocity into their ground (normal velocity ``v_n < 0``
+    and distance ``gap`` at the step's start: nodes arriving in this step, and resting nodes that a
+    collision impulse pushed into the ground). Such a node loses its normal momentum in whatever
+    step it happens (a point mass hitting a rigid wall), so no step size could bring that part under
     a tolerance; the remainder grows with ``h`` and is what the step-size control bounds. The same
     holds for the Coulomb friction on an arriving node while it is stopped, at most ``mu`` times that
     normal impulse: the tangential impulse of an arriving node is counted only above
@@ -462,13 +471,15 @@ def try_step(model, solver, state, trial, h, ws):
     velocity before :func:`_rest_on_grounds` removes it).
 
     With ring collision, the collision impulses are found on the predicted positions ``x0 + h v0``
-    and added to the start velocities (``collision.py``); each ring's energy guard is credited with
-    the change of its kinetic energy by them. They are not part of the contact impulse (the part
-    that stops an approaching node does not shrink with the step).
+    and added to the start velocities (``collision.py``); each ring's energy guard and energy budget
+    are credited with the change of its kinetic energy by them. Their sum over rings is negative
+    (energy lost) except where they push out nodes that start the step inside the contact distance
+    (a Baumgarte-type term): that net gain is tallied in ``ws.energy_tally``. They are not part of
+    the contact impulse (the part that stops an approaching node does not shrink with the step).
     """
     total = 0
     impulse = 0.0
-    ws.projection[:] = 0.0
+    ws.energy_tally[:] = 0.0
     contact = model.contact_method != CONTACT_NONE
     cw = ws.collision
     v0 = state.v
@@ -479,6 +490,10 @@ def try_step(model, solver, state, trial, h, ws):
             state.x, state.v, h, model.thickness, model.node_mass, model.collide,
             model.reject_self_intersection, cw, v0, cw.kinetic_change,
         )  # fmt: skip
+        created = 0.0
+        for r in range(state.x.shape[0]):
+            created += cw.kinetic_change[r]
+        ws.energy_tally[TALLY_COLLISION_GAIN] = max(0.0, created)
     for r in range(state.x.shape[0]):
         trial.active[r] = state.active[r]
         its = newton_ring(
@@ -515,10 +530,11 @@ def try_step(model, solver, state, trial, h, ws):
                 trial.contact_force[r, i, 1] = fy
                 jx += h * fx
                 jy += h * fy
-                if state.active[r, i] == FREE:
-                    # the reaction that stops the node on the surface: kappa m (v_n + gap / h)
-                    gap = max(0.0, nx * state.x[r, i, 0] + ny * state.x[r, i, 1] - model.grounds[g, 2])
-                    vn = min(0.0, v0[r, i, 0] * nx + v0[r, i, 1] * ny + gap / h)
+                # the reaction that stops the node's start velocity into the surface (an arriving
+                # node, or a resting one pushed by a collision impulse): kappa m (v_n + gap / h)
+                gap = max(0.0, nx * state.x[r, i, 0] + ny * state.x[r, i, 1] - model.grounds[g, 2])
+                vn = min(0.0, v0[r, i, 0] * nx + v0[r, i, 1] * ny + gap / h)
+                if vn < 0.0:
                     jx += m * vn * nx
                     jy += m * vn * ny
                     # and the friction that comes with it, at most mu times that normal impulse
@@ -616,8 +632,9 @@ def advance(model, solver, ws, state, trial, clock, counters, t_pause, t_end, ou
             clock[CLOCK_H] = max(solver.dt_min, h * max(0.2, 0.9 * ratio))
             continue
         counters[COUNT_STEPS] += 1
-        counters[COUNT_ENERGY_PROJECTED] += int(ws.projection[0])
-        clock[CLOCK_ENERGY_REMOVED] += ws.projection[1]
+        counters[COUNT_ENERGY_PROJECTED] += int(ws.energy_tally[TALLY_PROJECTED])
+        clock[CLOCK_ENERGY_REMOVED] += ws.energy_tally[TALLY_REMOVED]
+        clock[CLOCK_COLLISION_GAIN] += ws.energy_tally[TALLY_COLLISION_GAIN]
         counters[COUNT_EVENTS] = detect_events(model, state, trial, t, h, rec.events, counters[COUNT_EVENTS])
         _accept(state, trial)
         clock[CLOCK_T] = stop

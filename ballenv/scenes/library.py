@@ -308,6 +308,7 @@ def _concatenate(parts, scene):
         rejections={k: sum(x.rejections.get(k, 0) for x in s) for k in s[0].rejections},
         energy_projected=sum(x.energy_projected for x in s),
         energy_removed=sum(x.energy_removed for x in s),
+        collision_gain=sum(x.collision_gain for x in s),
     )
     return Trajectory(
         t=np.concatenate([p.t for p in parts]),
