@@ -9,7 +9,7 @@ preset     nodes   largest dt   impulse_tol       newton_tol    first-apex error
 =========  ======  ===========  ================  ============  ====================  ===========
 fast       32      0.02 s       0.01 N s          1e-6          3.2 % (bound 5 %)     7-11 ms
 balanced   64      0.01 s       0.002 N s         1e-9          0.22 % (bound 0.5 %)  28-42 ms
-accurate   128     0.005 s      0.0005 N s        1e-10         0.12 % (bound 0.3 %)  139-188 ms
+accurate   128     0.005 s      0.0005 N s        1e-10         0.12 % (bound 0.3 %)  139-237 ms
 =========  ======  ===========  ================  ============  ====================  ===========
 
 Errors and wall times are measured by ``benchmarks/work_precision.py`` on its single-bounce scene
@@ -21,7 +21,7 @@ study, balanced the knee at N = 64 (within 1 %, and 132x cheaper than the cheape
 backward-Euler run that is), accurate at the N = 128 front within timing noise, its error at the
 reference's resolution. A tighter ``impulse_tol`` for fast (5e-3 N s: 1.2 % error for 15 % more Newton
 iterations) was not taken: violent paddle strikes in the env then end in "impulse above
-impulse_tol at dt_min" simulator failures. Wall times: range over four runs of the benchmark.
+impulse_tol at dt_min" simulator failures. Wall times: range over five runs of the benchmark.
 """
 
 import dataclasses
