@@ -32,10 +32,10 @@ from ..physics.model import (
 )
 from ..physics.stepper import (
     CLOCK_H,
-    CLOCK_T,
     COUNT_EVENTS,
     COUNT_RECORDS,
     ENERGY_BUDGET,
+    ENERGY_FREE,
     ENERGY_TOTAL,
     N_CLOCK,
     N_COUNTERS,
@@ -160,7 +160,7 @@ def reset_env(
     else:
         restart(me, 0, x, v, se.a[0], se.active[0], se.energy[0], ws)
     se.energy[0, ENERGY_BUDGET] = se.energy[0, ENERGY_TOTAL]  # a new episode starts a new budget
-    clocks[e, CLOCK_T] = 0.0
+    clocks[e, :] = 0.0
     clocks[e, CLOCK_H] = solver.dt
     counters[e, :] = 0
     task.target[e] = target
@@ -189,7 +189,7 @@ def _rise(me, se, task, e):
     x = se.x[0]
     cy = centre_of_mass(x, se.v[0])[1]
     weight = x.shape[0] * me.node_mass[0] * task.gravity
-    return se.energy[0, 1] / weight + cy - task.ground_height - task.rest_radius[e]
+    return se.energy[0, ENERGY_FREE] / weight + cy - task.ground_height - task.rest_radius[e]
 
 
 @njit(cache=True)

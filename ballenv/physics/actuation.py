@@ -35,8 +35,8 @@ def rest_circle_radius(model, r, pressure, n_nodes):
 def set_rest_pressure(model, r, pressure, x, v, a, active, energy, ws):
     """Set ring ``r``'s gas to the amount with gauge pressure ``pressure`` (Pa) at rest (see module
     doc): updates ``model.gas_constant[r]`` and ``model.rest_energy[r]``, then the ring's carried
-    ``energy`` (2,) and start acceleration ``a`` (N, 2) for state ``x, v`` with contact set
-    ``active``. ``ws.xe``/``ws.ve`` are used as scratch."""
+    ``energy`` (3,: energy, free part, budget; see :func:`restart`) and start acceleration ``a``
+    (N, 2) for state ``x, v`` with contact set ``active``. ``ws.xe``/``ws.ve`` are used as scratch."""
     n = x.shape[0]
     radius = rest_circle_radius(model, r, pressure, n)
     circle = ws.xe

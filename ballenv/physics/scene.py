@@ -183,9 +183,10 @@ class Scene:
             iteration; the system keeps its size) or "predictor_corrector" (the paper's first
             method: the whole step is recomputed after each change of the contact set).
         impulse_tol: largest contact impulse per step ``f dt`` (N s) in (0, 10] when ``adaptive``: a
-            ring's total ground reaction over the step, net of the momentum of nodes arriving on the
-            ground in it (see ``stepper.try_step``); larger steps are rejected and shrunk by the
-            ratio, smaller ones grow by at most x1.25.
+            ring's total ground reaction over the step, net of the momentum that stops nodes moving
+            into the ground at the step's start (arriving ones, or resting ones a collision impulse
+            pushed; see ``stepper.try_step``); larger steps are rejected and shrunk by the ratio,
+            smaller ones grow by at most x1.25.
         friction_regularization: slip speed eps (m/s) in (0, 1] below which Coulomb friction is
             smoothed, ``mu N v / sqrt(v^2 + eps^2)``. A sticking node creeps at about eps times its
             tangential load over mu N (a ball rolling down a 0.2 rad slope: 0.5 mm/s at the default

@@ -30,6 +30,7 @@ from .stepper import (
     COUNT_REJECTED,
     COUNT_REJECTION,
     COUNT_STEPS,
+    N_CLOCK,
     N_COUNTERS,
     REJECT_ENERGY,
     REJECT_INTRUSION,
@@ -219,7 +220,8 @@ def simulate(scene, t_end, x0=None, v0=None, output_dt=None, progress=False):
         _check_apart(model, state.x, ws)
     initial_state_values(model, solver, state, ws)
     trial = empty_state(n_rings, n_nodes)
-    clock = np.array([0.0, solver.dt, 0.0, 0.0])  # see stepper.CLOCK_*
+    clock = np.zeros(N_CLOCK)
+    clock[CLOCK_H] = solver.dt
     counters = np.zeros(N_COUNTERS, dtype=np.int64)
 
     capacity = 1 + (int(np.ceil(t_end / output_dt)) + 1 if output_dt else 1024)

@@ -73,7 +73,7 @@ REJECT_INTRUSION = 3  # a node of one ring ended inside another ring
 REJECT_SELF_INTERSECTION = 4  # a ring's polygon crossed itself
 REJECTION_REASONS = {
     REJECT_NEWTON: "Newton's iteration did not converge",
-    REJECT_ENERGY: "the step gained energy",
+    REJECT_ENERGY: "the step gained energy (more than the energy budget can take back)",
     REJECT_INTRUSION: "a node of one ring ended inside another ring",
     REJECT_SELF_INTERSECTION: "a ring's wall crossed itself",
 }
@@ -148,6 +148,22 @@ def _energy_grew(total_before, free_before, total_after, free_after):
 
 
 @njit(cache=True)
+def _energy_scale(model, r, x, parts):
+    """Size (J) of the terms that make up ring ``r``'s energy, for round-off tolerances: the sum of
+    |energy parts| ``parts`` (5,), with gravity's part taken node by node, ``m |g_d x_i,d|`` summed
+    (the ring's gravity energy can cancel to nearly 0 while its nodes' terms do not)."""
+    scale = 0.0
+    for k in range(parts.shape[0]):
+        if k != ENERGY_GRAVITY:
+            scale += abs(parts[k])
+    if model.use_gravity:
+        for i in range(x.shape[0]):
+            for d in range(2):
+                scale += model.node_mass[r] * abs(model.gravity[d] * x[i, d])
+    return scale
+
+
+@njit(cache=True)
 def _within_energy_budget(model, r, before, kick, trial, ws):
     """Hold ring ``r``'s energy after a trial step to its budget ``trial.energy[r, ENERGY_BUDGET]``
     (J): its energy at the start of the run plus what actuation and collision impulses gave it
@@ -162,20 +178,23 @@ def _within_energy_budget(model, r, before, kick, trial, ws):
     oscillates by about ``h^2.5``); whatever of it lifts the energy above the budget is removed from
     the ring's velocities relative to its centre of mass, keeping its momentum
     (:func:`energy.remove_internal_kinetic_energy`), ``trial.energy[r]`` is recomputed and the
-    removal is tallied in ``ws.energy_tally``. Returns False as well if the ring's spin and
-    deformation hold less kinetic energy than that excess (and the excess is above round-off,
-    1e-12 of the budget)."""
+    removal is tallied in ``ws.energy_tally``; ground-constrained nodes are then put back at rest
+    in their ground's normal direction (which only lowers the energy further). If the ring's spin
+    and deformation hold too little kinetic energy to pay the excess (a ring in rigid translation),
+    an excess within round-off (1e-12 of :func:`_energy_scale`) is accepted as it is and a larger
+    one returns False. ``ws.energy`` must hold the energy parts of the trial state (as
+    :func:`free_energy` leaves them)."""
     after = trial.energy[r]
     if _energy_grew(
         before[ENERGY_TOTAL] + kick, before[ENERGY_FREE] + kick, after[ENERGY_TOTAL], after[ENERGY_FREE]
     ):
         return False
-    budget = after[ENERGY_BUDGET]
-    excess = after[ENERGY_TOTAL] - budget
+    excess = after[ENERGY_TOTAL] - after[ENERGY_BUDGET]
     if excess <= 0.0:
         return True
     if not remove_internal_kinetic_energy(trial.v[r], model.node_mass[r], excess):
-        return excess <= 1e-12 * abs(budget)
+        return excess <= 1e-12 * _energy_scale(model, r, trial.x[r], ws.energy)
+    _rest_on_grounds(model.grounds, trial.active[r], trial.v[r], trial.a[r])
     free_energy(model, r, trial.x[r], trial.v[r], ws.energy, after)
     ws.energy_tally[TALLY_PROJECTED] += 1.0
     ws.energy_tally[TALLY_REMOVED] += excess
@@ -462,10 +481,10 @@ def try_step(model, solver, state, trial, h, ws):
     collision impulse pushed into the ground). Such a node loses its normal momentum in whatever
     step it happens (a point mass hitting a rigid wall), so no step size could bring that part under
     a tolerance; the remainder grows with ``h`` and is what the step-size control bounds. The same
-    holds for the Coulomb friction on an arriving node while it is stopped, at most ``mu`` times that
-    normal impulse: the tangential impulse of an arriving node is counted only above
-    ``mu kappa m |v_n + gap / h|`` (without this, a sliding impact left a floor ``mu m v_n`` per arriving
-    node that no step size could bring under ``impulse_tol``). ``kappa`` is
+    holds for the Coulomb friction on such a node while it is stopped, at most ``mu`` times that
+    normal impulse: its tangential impulse is counted only above ``mu kappa m |v_n + gap / h|``
+    (without this, a sliding impact left a floor ``mu m v_n`` per arriving node that no step size
+    could bring under ``impulse_tol``). ``kappa`` is
     the integrator's reaction to an arrival per unit momentum: 1 for backward Euler,
     ``(1 - alpha_m) / beta`` for generalized-alpha (whose Newmark update reflects the node's normal
     velocity before :func:`_rest_on_grounds` removes it).

@@ -128,3 +128,19 @@ def test_rgb_array_render_is_an_image_and_opens_no_window():
     assert frame.dtype == np.uint8 and frame.ndim == 3 and frame.shape[2] == 3
     assert len(np.unique(frame.reshape(-1, 3), axis=0)) > 3  # ring, ground, text drawn
     assert not pygame.display.get_init()
+
+
+def test_pressure_actions_move_the_energy_budget_and_reset_starts_a_new_one():
+    env = InflatedBallEnv(action_mode="pressure")
+    env.reset(seed=3)
+    energy = env._batch.state.energy[0]
+    assert energy[2] == energy[0]  # budget = energy at the start
+    start = float(energy[2])
+    for _ in range(20):
+        env.step(np.array([1.0], dtype=np.float32))  # pump: actuation work raises the budget
+    assert energy[2] > start
+    assert energy[0] <= energy[2] + 1e-12 * abs(energy[2])  # the energy never above it
+    raised = energy[2]
+    env.reset(seed=4)
+    assert energy[2] == energy[0] != raised
+    assert np.all(env._batch.clocks[0, 2:] == 0.0)  # the run's energy tallies restart too

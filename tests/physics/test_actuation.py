@@ -5,10 +5,10 @@ import pytest
 
 from ballenv.physics import Ground, Ring, Scene
 from ballenv.physics.actuation import apply_impulse, rest_circle_radius, set_rest_pressure
-from ballenv.physics.model import build_model, build_workspace, empty_state
+from ballenv.physics.model import build_model, build_solver, build_workspace, empty_state
 from ballenv.physics.ring import inflated_radius, total_mass
 from ballenv.physics.simulate import initial_state
-from ballenv.physics.stepper import free_energy, ring_force, ring_pressure
+from ballenv.physics.stepper import free_energy, initial_state_values, ring_force, ring_pressure
 
 
 def _ring_state(scene):
@@ -44,10 +44,12 @@ def test_new_gas_amount_makes_its_inflated_circle_the_rest_state(n_nodes, pressu
 def test_gas_change_updates_the_carried_energy_and_acceleration():
     scene = Scene(rings=[Ring(n_nodes=32, pressure=30e3)], grounds=[Ground()], gravity=9.81)
     model, ws, state = _ring_state(scene)
+    initial_state_values(model, build_solver(scene), state, ws)
+    before = state.energy[0].copy()
+    assert before[2] == before[0] != 0.0  # the budget starts at the ring's energy
     set_rest_pressure(
         model, 0, 50e3, state.x[0], state.v[0], state.a[0], state.active[0], state.energy[0], ws
     )
-    before = state.energy[0].copy()
     expected = np.zeros(2)
     free_energy(model, 0, state.x[0], state.v[0], ws.energy, expected)
     np.testing.assert_allclose(state.energy[0, :2], expected, rtol=1e-14)

@@ -189,9 +189,13 @@ def test_head_on_collision_conserves_momentum_and_mirror_symmetry(integrator):
     assert np.abs(image - traj.x[:, 1]).max() <= 1e-9
     assert no_intrusion(traj.x, np.full(2, m.thickness))
     energy = traj.energy()["total"].sum(axis=1)
-    # never above the start plus what the collision push-out created (the rings' energy budgets)
-    assert energy.max() <= energy[0] + traj.stats.collision_gain + 1e-12 * abs(energy[0])
-    assert energy[-1] <= energy[0]
+    kinetic = traj.energy()["kinetic"][0].sum()
+    # the push-out of nodes inside the contact distance created energy (measured: 1.4 % of the
+    # kinetic energy with generalized-alpha, 18 % with backward Euler), yet the total never rose
+    # above its start: the impulses' stopping of the approach took more
+    assert 0.0 < traj.stats.collision_gain < 0.25 * kinetic
+    assert energy.max() <= energy[0] + 1e-12 * abs(energy[0])
+    assert energy[-1] < energy[0] - 0.05 * kinetic
 
 
 def test_thirty_metres_per_second_head_on_does_not_tunnel():

@@ -101,3 +101,15 @@ def test_generalized_alpha_spinning_ring_stays_within_its_energy_budget():
     )
     spin = _spin(traj)
     assert np.max(np.abs(spin - spin[0])) < 2e-3 * spin[0]
+
+
+def test_generalized_alpha_translating_ring_is_not_stopped_by_round_off_of_its_budget():
+    # regression (review): a ring in rigid translation has no internal kinetic energy to pay for
+    # an energy excess; the round-off excess of free fall then rejected every step down to dt_min
+    ring = Ring(pressure=None, position=(0.0, 0.0), n_nodes=32)
+    scene = Scene(rings=[ring], gravity=9.81, integrator="generalized_alpha", adaptive=False, dt=1e-3)
+    traj = simulate(scene, 0.05)
+    assert traj.t[-1] == pytest.approx(0.05)
+    energy = traj.energy()
+    total = energy["total"][:, 0]
+    assert np.max(total - total[0]) <= 1e-9 * energy["kinetic"][-1, 0]
