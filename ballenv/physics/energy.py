@@ -9,7 +9,7 @@ import math
 from numba import njit
 
 from .elastic import bend_energy, stretch_energy
-from .loads import gas_energy, gravity_energy, polygon_area
+from .loads import centre_of_mass, gas_energy, gravity_energy, polygon_area
 
 ENERGY_KINETIC = 0
 ENERGY_STRETCHING = 1
@@ -41,10 +41,10 @@ def ring_energy(model, r, x, v, parts):
 
 
 @njit(cache=True)
-def remove_internal_kinetic_energy(v, m, excess):
-    """Lower the kinetic energy of a ring (node velocities ``v`` (N, 2) m/s, equal node masses ``m``
-    kg) by ``excess`` (J) without changing its momentum: the velocities relative to the mean ``V``
-    are scaled, ``v_i <- V + s (v_i - V)`` with ``s = sqrt(1 - excess / K_int)`` and
+def remove_internal_kinetic_energy(x, v, m, excess):
+    """Lower the kinetic energy of a ring (nodes ``x`` (N, 2) m, velocities ``v`` (N, 2) m/s, equal
+    node masses ``m`` kg) by ``excess`` (J) without changing its momentum: the velocities relative
+    to the mean ``V`` are scaled, ``v_i <- V + s (v_i - V)`` with ``s = sqrt(1 - excess / K_int)`` and
     ``K_int = m/2 sum |v_i - V|^2`` the kinetic energy of spin and deformation. This is the
     smallest change of ``v`` (in the mass norm) that removes ``excess`` and keeps the momentum; it
     lowers the angular momentum about the centre of mass by the factor ``s`` (a velocity
@@ -52,13 +52,7 @@ def remove_internal_kinetic_energy(v, m, excess):
     ``v`` untouched, if ``K_int <= excess``.
     """
     n = v.shape[0]
-    vx = 0.0
-    vy = 0.0
-    for i in range(n):
-        vx += v[i, 0]
-        vy += v[i, 1]
-    vx /= n
-    vy /= n
+    _, _, vx, vy = centre_of_mass(x, v)
     internal = 0.0
     for i in range(n):
         internal += (v[i, 0] - vx) ** 2 + (v[i, 1] - vy) ** 2

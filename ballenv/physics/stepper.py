@@ -130,10 +130,11 @@ def ring_force(model, r, x, v, f):
 
 @njit(cache=True)
 def free_energy(model, r, x, v, parts, out):
-    """``out[0]`` = the energy (J) of ring ``r``; ``out[1]`` = its free part: kinetic plus elastic and
-    gas energy above the inflated circle at rest (``Model.rest_energy``), gravity left out."""
-    out[0] = ring_energy(model, r, x, v, parts)
-    out[1] = out[0] - parts[ENERGY_GRAVITY] - model.rest_energy[r]
+    """``out[ENERGY_TOTAL]`` = the energy (J) of ring ``r``; ``out[ENERGY_FREE]`` = its free part:
+    kinetic plus elastic and gas energy above the inflated circle at rest (``Model.rest_energy``),
+    gravity left out. Other columns of ``out`` are left alone."""
+    out[ENERGY_TOTAL] = ring_energy(model, r, x, v, parts)
+    out[ENERGY_FREE] = out[ENERGY_TOTAL] - parts[ENERGY_GRAVITY] - model.rest_energy[r]
 
 
 @njit(cache=True)
@@ -192,7 +193,7 @@ def _within_energy_budget(model, r, before, kick, trial, ws):
     excess = after[ENERGY_TOTAL] - after[ENERGY_BUDGET]
     if excess <= 0.0:
         return True
-    if not remove_internal_kinetic_energy(trial.v[r], model.node_mass[r], excess):
+    if not remove_internal_kinetic_energy(trial.x[r], trial.v[r], model.node_mass[r], excess):
         return excess <= 1e-12 * _energy_scale(model, r, trial.x[r], ws.energy)
     _rest_on_grounds(model.grounds, trial.active[r], trial.v[r], trial.a[r])
     free_energy(model, r, trial.x[r], trial.v[r], ws.energy, after)

@@ -58,9 +58,8 @@ class Audit:
         """The run reached t_end, or stopped with a SimulationError that names why and what to change."""
         return self.reached_end or any(name in self.error for name in DOCUMENTED_ERRORS)
 
-    def problems(self, energy_tol=ENERGY_ROUND_OFF):
-        """Human-readable list of violated invariants (empty: the run is stable); ``energy_tol``:
-        the largest relative energy growth accepted."""
+    def problems(self):
+        """Human-readable list of violated invariants (empty: the run is stable)."""
         out = []
         if not self.finite:
             out.append("non-finite state")
@@ -68,7 +67,7 @@ class Audit:
             out.append(f"ground penetration {self.penetration:.3g} m")
         if self.intrusion > 0.0:
             out.append(f"ring intrusion {self.intrusion:.3g} m")
-        if self.energy_growth > energy_tol + self.collision_gain:
+        if self.energy_growth > ENERGY_ROUND_OFF + self.collision_gain:
             out.append(
                 f"energy growth {self.energy_growth:.3g} (relative; push-out {self.collision_gain:.3g})"
             )
