@@ -40,7 +40,7 @@ class HeuristicPolicy:
 
     def __init__(self, env):
         config = env.unwrapped.config
-        structure = env.unwrapped._structure
+        structure = env.unwrapped.observation_structure
         if config.action_mode == "pressure":
             self.controller = PressurePump(structure, gravity=config.gravity)
         else:

@@ -2,11 +2,18 @@
 
 Importing the package registers ``InflatedBall-v0`` with Gymnasium (Gymnasium 1.x has no plugin
 entry point): ``import ballenv; gym.make("InflatedBall-v0")``, or, without the import (e.g. in
-spawned subprocesses), ``gym.make("ballenv:InflatedBall-v0")``.
+spawned subprocesses), ``gym.make("ballenv:InflatedBall-v0")``. Without gymnasium installed the
+simulator, ``ballenv.physics``, still imports (it needs only numpy, numba and tqdm).
 """
-
-from .envs import register_envs
 
 __version__ = "0.1.0"
 
-register_envs()
+try:
+    import gymnasium  # noqa: F401
+except ModuleNotFoundError as missing:  # the simulator alone (ballenv.physics) needs no gymnasium
+    if missing.name != "gymnasium":
+        raise
+else:
+    from .envs import register_envs
+
+    register_envs()

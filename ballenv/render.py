@@ -7,7 +7,7 @@ target and the paddle. The view follows the ball horizontally and spans the aren
 import numpy as np
 
 from .envs.batch import MODE_PADDLE, env_model
-from .physics.stepper import ring_pressure
+from .physics.effects.gas import ring_pressure
 
 SIZE = 480  # pixels, square
 BACKGROUND = (250, 250, 247)
@@ -126,15 +126,14 @@ def frame_strip(out, steps=(0, 30, 36, 42, 90), seed=3):
     rows = []
     for mode in ("pressure", "paddle"):
         env = gym.make("InflatedBall-v0", action_mode=mode, render_mode="rgb_array")
-        obs, info = env.reset(seed=seed)
+        obs, _ = env.reset(seed=seed)
         config = env.unwrapped.config
+        structure = env.unwrapped.observation_structure
         if mode == "pressure":
-            controller = PressurePump(info["observation_structure"])
+            controller = PressurePump(structure)
         else:
             mass = total_mass(config.ring(config.initial_pressure))
-            controller = PaddleDribble(
-                info["observation_structure"], mass, max_impulse=config.paddle_max_impulse
-            )
+            controller = PaddleDribble(structure, mass, max_impulse=config.paddle_max_impulse)
         frames = []
         for k in range(max(steps) + 1):
             if k in steps:

@@ -24,7 +24,7 @@ import sys
 
 import numpy as np
 
-from .physics.simulate import Trajectory
+from .physics.simulation import Trajectory
 
 
 def _b64(array):

@@ -48,7 +48,7 @@ def controller(env, mode, structure):
 def single_rate(preset, mode, policy, repeats=3):
     env = gym.make("InflatedBall-v0", action_mode=mode, fidelity=preset)
     obs, info = env.reset(seed=0)
-    ctrl = controller(env, mode, info["observation_structure"])
+    ctrl = controller(env, mode, env.unwrapped.observation_structure)
     env.action_space.seed(0)
     for _ in range(50):  # warm-up (compiles on the first run)
         obs, *_ = env.step(env.action_space.sample())

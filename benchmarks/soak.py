@@ -1,4 +1,4 @@
-"""Soak run of the stability suite (issue 8): thousands of random scenes and env episodes, seeded.
+"""Soak run of the stability suite (``tests/stability``): thousands of random scenes and env episodes, seeded.
 
     python benchmarks/soak.py [--scenes 2000] [--episodes 400] [--seed 0]
     # prints the table, writes benchmarks/results/soak.md
@@ -148,23 +148,32 @@ def soak_scenes(count, seed):
     return tally, rejected, ends, growth, removed, worst, crashes
 
 
+POLICIES = ("uniform", "plus", "minus", "alternating")
+
+
+def episode_action(policy, rng, step):
+    """The action of ``policy`` at ``step``: uniform in [-1, 1], +1, -1, or alternating -1 / +1 (a
+    uniform number is drawn from ``rng`` at every step whatever the policy)."""
+    return {
+        "uniform": rng.uniform(-1.0, 1.0),
+        "plus": 1.0,
+        "minus": -1.0,
+        "alternating": 1.0 if step % 2 else -1.0,
+    }[policy]
+
+
 def soak_episodes(count, seed, steps=250):
     rng = np.random.default_rng(seed)
     tally = Counter()
     envs = {mode: InflatedBallEnv(action_mode=mode) for mode in ("pressure", "paddle")}
     for k in tqdm(range(count), desc="episodes", unit="ep"):
         mode = ("pressure", "paddle")[k % 2]
-        policy = ("uniform", "plus", "minus", "alternating")[(k // 2) % 4]
+        policy = POLICIES[(k // 2) % 4]
         env = envs[mode]
         env.reset(seed=int(rng.integers(2**31)))
         tally["episodes"] += 1
         for s in range(steps):
-            a = {
-                "uniform": rng.uniform(-1.0, 1.0),
-                "plus": 1.0,
-                "minus": -1.0,
-                "alternating": 1.0 if s % 2 else -1.0,
-            }[policy]
+            a = episode_action(policy, rng, s)
             obs, reward, terminated, truncated, info = env.step(np.array([a], dtype=np.float32))
             tally["env steps"] += 1
             x = env._batch.state.x[0]

@@ -31,7 +31,7 @@ def _episode(env, seed, controller, idle):
 )
 def test_scripted_controller_keeps_the_target_the_uncontrolled_ball_cannot(mode, targets):
     env = gym.make("InflatedBall-v0", action_mode=mode, target_height_range=targets)
-    structure = env.reset(seed=0)[1]["observation_structure"]
+    structure = env.unwrapped.observation_structure
     config = env.unwrapped.config
     if mode == "pressure":
         controller = PressurePump(structure)

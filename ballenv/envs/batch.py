@@ -19,31 +19,48 @@ from numba import njit
 
 from ..physics.actuation import apply_impulse, rest_circle_radius, restart, set_rest_pressure
 from ..physics.contact import FREE
-from ..physics.events import EVENT_APEX, EVENT_LIFTOFF, EVENT_TOUCHDOWN
-from ..physics.loads import centre_of_mass
-from ..physics.model import (
-    Model,
-    Recording,
-    State,
-    build_model,
-    build_solver,
-    build_workspace,
-    empty_state,
-)
-from ..physics.stepper import (
+from ..physics.effects.gas import ring_pressure
+from ..physics.geometry import centre_of_mass
+from ..physics.integrator import build_solver
+from ..physics.layout import (
     CLOCK_H,
     COUNT_EVENTS,
     COUNT_RECORDS,
     ENERGY_BUDGET,
     ENERGY_FREE,
     ENERGY_TOTAL,
+    EVENT_APEX,
+    EVENT_LIFTOFF,
+    EVENT_TOUCHDOWN,
     N_CLOCK,
     N_COUNTERS,
     STATUS_BUFFER_FULL,
     STATUS_DONE,
-    advance,
-    ring_pressure,
 )
+from ..physics.model import (
+    PER_RING_FIELDS,
+    Recording,
+    build_model,
+    build_workspace,
+    empty_state,
+    rings_view,
+)
+from ..physics.stepper import advance
+from .observation import (
+    OBS_CENTRE_OF_MASS_POSITION,
+    OBS_CENTRE_OF_MASS_VELOCITY,
+    OBS_GROUND_NORMAL_FORCE,
+    OBS_NODE_POSITION,
+    OBS_NODE_VELOCITY,
+    OBS_PADDLE_HEIGHT,
+    OBS_PADDLE_IMPULSE,
+    OBS_PADDLE_IN_REACH,
+    OBS_PRESSURE,
+    OBS_TARGET_HEIGHT,
+    field_start,
+)
+from .observation import size as layout_size
+from .observation import structure as layout_structure
 
 MODE_PRESSURE = 0
 MODE_PADDLE = 1
@@ -96,23 +113,14 @@ class Task(NamedTuple):
 
 @njit(cache=True)
 def env_model(model, e):
-    """The one-ring Model of env ``e`` (views of its slices)."""
-    s = slice(e, e + 1)
-    return Model(
-        model.node_mass[s], model.ea[s], model.ei[s], model.rest_len[s], model.rest_turn[s],
-        model.width[s], model.radius[s], model.pressurised[s], model.gas_constant[s],
-        model.gas_exponent, model.atmospheric_pressure, model.gravity, model.use_gravity,
-        model.damping, model.damping_mode, model.grounds, model.contact_method,
-        model.friction_regularization, model.impulse_tol, model.rest_energy[s], model.thickness[s],
-        False, model.reject_self_intersection,
-    )  # fmt: skip
+    """The one-ring Model of env ``e`` (views of its per-ring fields, ``model.PER_RING_FIELDS``)."""
+    return rings_view(model, e, e + 1)
 
 
 @njit(cache=True)
 def env_state(state, e):
     """The one-ring State of env ``e`` (views of its slices)."""
-    s = slice(e, e + 1)
-    return State(state.x[s], state.v[s], state.a[s], state.active[s], state.contact_force[s], state.energy[s])
+    return rings_view(state, e, e + 1)
 
 
 @njit(cache=True)
@@ -303,8 +311,9 @@ def _outcome(task, e, row, n):
     apex ``-w sum |h - h_t| / h_t``; shaping ``-w dt |h_reach - h_t| / h_t`` with ``h_reach = r +
     rise``; termination ``-w`` per apex left until ``termination_horizon`` (one per flight time
     ``2 sqrt(2 (h_t - r) / g)``) when the ball rests, leaves the arena or the simulator fails."""
-    cx = row[4 * n]
-    cy = row[4 * n + 1]
+    centre = field_start(OBS_CENTRE_OF_MASS_POSITION, n)
+    cx = row[centre]
+    cy = row[centre + 1]
     target = task.target[e]
     apex = -task.apex_weight * task.apex_error[e]
     reach = task.rest_radius[e] + task.rise[e]
@@ -330,54 +339,44 @@ def _outcome(task, e, row, n):
 
 @njit(cache=True)
 def observe_env(model, state, task, e, row):
-    """Write env ``e``'s observation (see InflatedBallEnv's table, unclipped) into ``row``."""
+    """Write env ``e``'s observation (the fields of ``observation.FIELDS``, unclipped) into ``row``."""
     n = state.x.shape[1]
     nx, ny = model.grounds[0, 0], model.grounds[0, 1]
     x = state.x[e]
     v = state.v[e]
     cx, cy, ux, uy = centre_of_mass(x, v)
+    position = field_start(OBS_NODE_POSITION, n)
+    velocity = field_start(OBS_NODE_VELOCITY, n)
+    force = field_start(OBS_GROUND_NORMAL_FORCE, n)
     for i in range(n):
-        row[2 * i] = x[i, 0] - cx
-        row[2 * i + 1] = x[i, 1] - cy
-        row[2 * n + 2 * i] = v[i, 0] - ux
-        row[2 * n + 2 * i + 1] = v[i, 1] - uy
+        row[position + 2 * i] = x[i, 0] - cx
+        row[position + 2 * i + 1] = x[i, 1] - cy
+        row[velocity + 2 * i] = v[i, 0] - ux
+        row[velocity + 2 * i + 1] = v[i, 1] - uy
         f = state.contact_force[e, i]
-        row[4 * n + 4 + i] = f[0] * nx + f[1] * ny
-    row[4 * n] = cx
-    row[4 * n + 1] = cy - task.ground_height
-    row[4 * n + 2] = ux
-    row[4 * n + 3] = uy
-    k = 5 * n + 4
-    row[k] = ring_pressure(env_model(model, e), 0, x)
-    row[k + 1] = task.target[e]
+        row[force + i] = f[0] * nx + f[1] * ny
+    centre = field_start(OBS_CENTRE_OF_MASS_POSITION, n)
+    row[centre] = cx
+    row[centre + 1] = cy - task.ground_height
+    centre_velocity = field_start(OBS_CENTRE_OF_MASS_VELOCITY, n)
+    row[centre_velocity] = ux
+    row[centre_velocity + 1] = uy
+    row[field_start(OBS_PRESSURE, n)] = ring_pressure(env_model(model, e), 0, x)
+    row[field_start(OBS_TARGET_HEIGHT, n)] = task.target[e]
     if task.mode == MODE_PADDLE:
-        row[k + 2] = task.paddle_height[e]
-        row[k + 3] = 1.0 if task.in_reach[e] else 0.0
-        row[k + 4] = task.impulse[e]
+        row[field_start(OBS_PADDLE_HEIGHT, n)] = task.paddle_height[e]
+        row[field_start(OBS_PADDLE_IN_REACH, n)] = 1.0 if task.in_reach[e] else 0.0
+        row[field_start(OBS_PADDLE_IMPULSE, n)] = task.impulse[e]
 
 
 def observation_size(n_nodes, mode):
-    """Length of the observation vector."""
-    return 5 * n_nodes + 6 + (3 if mode == MODE_PADDLE else 0)
+    """Length of the observation vector in action mode ``mode`` (see ``observation.FIELDS``)."""
+    return layout_size(n_nodes, mode == MODE_PADDLE)
 
 
 def observation_structure(n_nodes, mode):
-    """Name -> slice of the observation vector (see InflatedBallEnv's observation table)."""
-    n = n_nodes
-    out = {
-        "node_position": slice(0, 2 * n),
-        "node_velocity": slice(2 * n, 4 * n),
-        "centre_of_mass_position": slice(4 * n, 4 * n + 2),
-        "centre_of_mass_velocity": slice(4 * n + 2, 4 * n + 4),
-        "ground_normal_force": slice(4 * n + 4, 5 * n + 4),
-        "pressure": slice(5 * n + 4, 5 * n + 5),
-        "target_height": slice(5 * n + 5, 5 * n + 6),
-    }
-    if mode == MODE_PADDLE:
-        out["paddle_height"] = slice(5 * n + 6, 5 * n + 7)
-        out["paddle_in_reach"] = slice(5 * n + 7, 5 * n + 8)
-        out["paddle_impulse"] = slice(5 * n + 8, 5 * n + 9)
-    return out
+    """Name -> slice of the observation vector in action mode ``mode`` (see ``observation.FIELDS``)."""
+    return layout_structure(n_nodes, mode == MODE_PADDLE)
 
 
 class BallBatch:
@@ -450,13 +449,9 @@ class BallBatch:
         )  # fmt: skip
 
 
-PER_RING_FIELDS = (
-    "node_mass", "ea", "ei", "rest_len", "rest_turn", "width", "radius", "pressurised", "gas_constant",
-    "rest_energy", "thickness",
-)  # fmt: skip
-
-
 def _tiled_model(model, n_envs):
     """``model`` of a one-ring scene with its per-ring arrays repeated for ``n_envs`` envs (the rings
     of different envs never meet: this is not a scene of many rings)."""
-    return model._replace(**{name: np.repeat(getattr(model, name), n_envs) for name in PER_RING_FIELDS})
+    return model._replace(
+        **{name: np.repeat(getattr(model, name), n_envs, axis=0) for name in PER_RING_FIELDS}
+    )

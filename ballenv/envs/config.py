@@ -11,12 +11,10 @@ from ..physics.presets import FIDELITY_PRESETS, with_fidelity
 from ..physics.ring import inflation_ratio_of
 from ..physics.scene import check_choice, check_real
 from ..physics.stepper import STATUS_IMPULSE_AT_DT_MIN, STATUS_STEP_TOO_SMALL
-from .batch import END_FAILURE, MODE_PADDLE, MODE_PRESSURE, observation_size
+from . import observation
+from .batch import END_FAILURE, MODE_PADDLE, MODE_PRESSURE
 
 ACTION_MODES = {"pressure": MODE_PRESSURE, "paddle": MODE_PADDLE}
-MAX_SPEED = 100.0  # m/s, bound of the velocity observations
-MAX_NODE_FORCE = 1e5  # N, bound of the per-node ground normal force observation
-MAX_PRESSURE = 1e7  # Pa, bound of the pressure observation
 FAILURES = {
     STATUS_STEP_TOO_SMALL: "rejected steps (Newton failure, energy gain or a self-crossing wall) "
     "halved the step below Scene.dt_min",
@@ -158,25 +156,9 @@ class BallEnvConfig:
         return self.radius / (1.0 - inflation_ratio_of(p, self.width, self.radius, self.n_nodes, ea))
 
     def observation_bounds(self):
-        """(low, high) float32 bounds of the observation vector; observations are clipped to them."""
-        n = self.n_nodes
-        size = observation_size(n, self.mode)
-        reach = 4.0 * self.largest_radius()
-        low = np.empty(size)
-        high = np.empty(size)
-        low[: 2 * n], high[: 2 * n] = -reach, reach
-        low[2 * n : 4 * n], high[2 * n : 4 * n] = -MAX_SPEED, MAX_SPEED
-        low[4 * n : 4 * n + 2] = (-self.arena_half_width, -1.0)
-        high[4 * n : 4 * n + 2] = (self.arena_half_width, self.arena_height)
-        low[4 * n + 2 : 4 * n + 4], high[4 * n + 2 : 4 * n + 4] = -MAX_SPEED, MAX_SPEED
-        low[4 * n + 4 : 5 * n + 4], high[4 * n + 4 : 5 * n + 4] = 0.0, MAX_NODE_FORCE
-        k = 5 * n + 4
-        low[k], high[k] = -101325.0, MAX_PRESSURE
-        low[k + 1], high[k + 1] = self.target_height_range
-        if self.mode == MODE_PADDLE:
-            low[k + 2 : k + 5] = (0.0, 0.0, 0.0)
-            high[k + 2 : k + 5] = (self.arena_height + reach, 1.0, self.paddle_max_impulse)
-        return low.astype(np.float32), high.astype(np.float32)
+        """(low, high) float32 bounds of the observation vector (``observation.FIELDS``); observations
+        are clipped to them."""
+        return observation.bounds(self, self.mode == MODE_PADDLE)
 
     @classmethod
     def from_kwargs(cls, kwargs):

@@ -38,7 +38,8 @@ class InflatedBallEnv(Env, EzPickle):
 
     ## Observation Space
     ``Box(low, high, (5 N + 6,), float32)`` (``+3`` in paddle mode), N nodes (32 for the "fast"
-    preset). Values are clipped to the bounds; ``info["observation_structure"]`` maps names to slices.
+    preset). Values are clipped to the bounds; ``env.unwrapped.observation_structure`` maps names to
+    slices. The layout is declared once, in ``ballenv.envs.observation``; this table repeats it.
 
     | Slice (name)             | Observation                                             | Unit | Bounds |
     |--------------------------|---------------------------------------------------------|------|--------|
@@ -129,10 +130,15 @@ class InflatedBallEnv(Env, EzPickle):
         self._batch = BallBatch(self.config.scene(), 1, self.config.task_settings(), low, high)
         self.observation_space = spaces.Box(low, high, dtype=np.float32)
         self.action_space = spaces.Box(-1.0, 1.0, shape=(1,), dtype=np.float32)
-        self._structure = observation_structure(self.config.n_nodes, self.config.mode)
+        self._observation_structure = observation_structure(self.config.n_nodes, self.config.mode)
         self._actions = np.zeros(1)
         self._renderer = None
         self.metadata = {**self.metadata, "render_fps": int(round(min(self.config.control_frequency, 50.0)))}
+
+    @property
+    def observation_structure(self):
+        """Name -> slice of the observation vector (a new dict: the caller may change it)."""
+        return dict(self._observation_structure)
 
     @property
     def dt(self):
@@ -145,7 +151,7 @@ class InflatedBallEnv(Env, EzPickle):
         self._batch.reset(0, centre, velocity, phase, target, self.config.initial_pressure)
         if self.render_mode == "human":
             self.render()
-        info = {"observation_structure": dict(self._structure), "target_height": float(target), "time": 0.0}
+        info = {"target_height": float(target), "time": 0.0}
         return self._batch.obs[0].copy(), info
 
     def step(self, action):
@@ -164,7 +170,6 @@ class InflatedBallEnv(Env, EzPickle):
         info = {name: float(task.reward[0, k + 1]) for k, name in enumerate(REWARD_TERMS)}
         reason = END_REASONS[int(task.end[0])]
         info.update(
-            observation_structure=dict(self._structure),
             time=float(task.steps[0] * self.config.control_dt),
             apex_count=int(task.apex_count[0]),
             apex_height=float(task.apex_height[0]),

@@ -59,11 +59,16 @@ class InflatedBallVectorEnv(VectorEnv):
         self.single_action_space = spaces.Box(-1.0, 1.0, shape=(1,), dtype=np.float32)
         self.observation_space = batch_space(self.single_observation_space, num_envs)
         self.action_space = batch_space(self.single_action_space, num_envs)
-        self._structure = observation_structure(self.config.n_nodes, self.config.mode)
+        self._observation_structure = observation_structure(self.config.n_nodes, self.config.mode)
         self._rngs = [seeding.np_random()[0] for _ in range(num_envs)]
         self._autoreset = np.zeros(num_envs, dtype=np.bool_)
         self._actions = np.zeros(num_envs)
         self._renderer = None
+
+    @property
+    def observation_structure(self):
+        """Name -> slice of each env's observation vector (a new dict: the caller may change it)."""
+        return dict(self._observation_structure)
 
     def reset(self, *, seed=None, options=None):
         super().reset(seed=seed)
@@ -82,11 +87,7 @@ class InflatedBallVectorEnv(VectorEnv):
             self._rngs[i], _ = seeding.np_random(s)
             self._reset_env(i)
         self._autoreset[:] = False
-        info = {
-            "observation_structure": dict(self._structure),
-            "target_height": self._batch.task.target.copy(),
-            "time": np.zeros(self.num_envs),
-        }
+        info = {"target_height": self._batch.task.target.copy(), "time": np.zeros(self.num_envs)}
         return self._batch.obs.copy(), info
 
     def _reset_env(self, i):

@@ -17,11 +17,12 @@ import math
 
 from numba import njit
 
+from .assembly import gravity_column, ring_energy, ring_force
 from .contact import FREE
-from .energy import ENERGY_GRAVITY, ring_energy
-from .loads import polygon_area
+from .energy import free_energy
+from .geometry import polygon_area
+from .layout import ENERGY_BUDGET, ENERGY_TOTAL
 from .ring import inflation_ratio_of
-from .stepper import ENERGY_BUDGET, ENERGY_TOTAL, free_energy, ring_force
 
 
 @njit(cache=True)
@@ -50,7 +51,8 @@ def set_rest_pressure(model, r, pressure, x, v, a, active, energy, ws):
     area = polygon_area(circle)
     model.gas_constant[r] = (pressure + model.atmospheric_pressure) * area**model.gas_exponent
     total = ring_energy(model, r, circle, still, ws.energy)
-    model.rest_energy[r] = total - ws.energy[ENERGY_GRAVITY]
+    g = gravity_column(model)
+    model.rest_energy[r] = total - (ws.energy[g] if g >= 0 else 0.0)
     restart(model, r, x, v, a, active, energy, ws)
 
 

@@ -551,3 +551,8 @@ def self_intersects(x):
             if _segments_cross(x[i, 0], x[i, 1], x[i1, 0], x[i1, 1], x[j, 0], x[j, 1], x[j1, 0], x[j1, 1]):
                 return True
     return False
+
+
+def enabled(scene):
+    """Two or more rings that collide (``Scene.ring_collision``)."""
+    return len(scene.rings) > 1 and scene.ring_collision

@@ -1,7 +1,8 @@
 """Ground half-planes: constrained nodes, reactions and Coulomb friction inside the Newton system.
 
 A ground ``g`` is the half-plane ``n_g . x >= d_g`` with unit normal ``n_g = (-sin a, cos a)`` for a
-slope angle ``a`` (rad) and ``d_g = height cos a`` (the surface passes through ``(0, height)``).
+slope angle ``a`` (rad) and ``d_g = n_g . (x_g, height)``: the surface passes through the ground's
+point ``(Ground.x, Ground.height)``.
 A node in contact is constrained on the surface and keeps the size of the system (Baraff & Witkin's
 filtered, mass-modified formulation written for the step's displacement): its two residual rows
 (``r_i = M inertia_i - F_i``, N) become
@@ -23,6 +24,7 @@ from numba import njit
 from .linalg import BAND_HALF_WIDTH
 
 FREE = -1
+PENETRATION_TOLERANCE = -1e-12  # m: a free node deeper than this below a ground gets constrained
 
 
 @njit(cache=True)
@@ -41,8 +43,7 @@ def deepest_ground(grounds, x, y):
 @njit(cache=True)
 def constrain_residual(grounds, active, x1, ve, res, node_mass, c_mass, eps, reaction, friction):
     """Replace the rows of active nodes (see module doc); store their normal reaction N_i (N) in
-    ``reaction`` and the friction force along t (N) in ``friction``. Returns the largest ``|r|`` scale
-    contribution of the constraint rows."""
+    ``reaction`` and the friction force along t (N) in ``friction``."""
     n = active.shape[0]
     for i in range(n):
         g = active[i]
@@ -117,3 +118,46 @@ def constrain_jacobian(grounds, active, ve, reaction, band, pos, u, rank, node_m
             else:
                 u[2 * i, k] = ut
                 u[2 * i + 1, k] = 0.0
+
+
+@njit(cache=True)
+def activate_penetrating(grounds, active, x1, only_deeper_than):
+    """Constrain free nodes below a ground; returns True if any was added."""
+    changed = False
+    for i in range(active.shape[0]):
+        if active[i] == FREE:
+            g, phi = deepest_ground(grounds, x1[i, 0], x1[i, 1])
+            if phi < only_deeper_than:
+                active[i] = g
+                changed = True
+    return changed
+
+
+@njit(cache=True)
+def rest_on_grounds(grounds, active, v1, a1):
+    """A constrained node ends the step at rest in the ground's normal direction (normal velocity
+    and algorithmic acceleration zeroed): it sits on the surface. Without this, backward Euler's
+    ``v1 = (x1 - x0) / h`` leaves a node that arrived from a gap a velocity into the ground, and the
+    Newmark update of generalized-alpha reflects it and leaves an acceleration spike that the alpha_m
+    term feeds back into the next steps (the known weakness of Newmark schemes with contact)."""
+    for i in range(active.shape[0]):
+        g = active[i]
+        if g == FREE:
+            continue
+        nx, ny = grounds[g, 0], grounds[g, 1]
+        vn = v1[i, 0] * nx + v1[i, 1] * ny
+        an = a1[i, 0] * nx + a1[i, 1] * ny
+        v1[i, 0] -= vn * nx
+        v1[i, 1] -= vn * ny
+        a1[i, 0] -= an * nx
+        a1[i, 1] -= an * ny
+
+
+def ground_enabled(scene):
+    """The scene has grounds: contact is on."""
+    return bool(scene.grounds)
+
+
+def friction_enabled(scene):
+    """A ground has friction."""
+    return any(g.friction > 0.0 for g in scene.grounds)

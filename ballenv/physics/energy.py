@@ -1,43 +1,100 @@
-"""Energy (J) of a ring: kinetic, stretching, bending, gas (the gas-law potential), gravity.
+"""A ring's energy budget: what it may hold after a step, and the removal of a small excess.
 
-Used by ``Trajectory.energy()`` and by the stepper's energy guard; ``Model.rest_energy`` is the
-value of the same sum (without gravity) on the ring's inflated circle at rest.
+Nothing in a scene adds energy but actuation (the gas amount, paddle impulses) and the push-out of
+collision impulses: the gas and gravity are potentials; damping, friction and the ground's
+constraints only remove it. Each ring carries ``State.energy[r]`` (columns ``layout.ENERGY``): its
+energy (J), its free part (kinetic plus elastic and gas energy above its inflated circle at rest,
+``Model.rest_energy``; gravity left out) and its budget (its energy at the start plus what
+actuation and collision impulses gave it since). The energy parts come from the effects
+(:func:`assembly.ring_energy`).
 """
 
 import math
 
 from numba import njit
 
-from .elastic import bend_energy, stretch_energy
-from .loads import centre_of_mass, gas_energy, gravity_energy, polygon_area
+from .assembly import gravity_column, ring_energy
+from .contact import rest_on_grounds
+from .geometry import centre_of_mass
+from .layout import ENERGY_BUDGET, ENERGY_FREE, ENERGY_TOTAL, TALLY_PROJECTED, TALLY_REMOVED
 
-ENERGY_KINETIC = 0
-ENERGY_STRETCHING = 1
-ENERGY_BENDING = 2
-ENERGY_GAS = 3
-ENERGY_GRAVITY = 4
-ENERGY_PARTS = ("kinetic", "stretching", "bending", "gas", "gravity")
+ENERGY_GROWTH_TOL = 1e-2  # largest energy gain of a step, relative to the ring's free energy
 
 
 @njit(cache=True)
-def ring_energy(model, r, x, v, parts):
-    """Energy (J) of ring ``r`` by part into ``parts`` (5,), in the order of ``ENERGY_PARTS``;
-    returns their sum."""
-    m = model.node_mass[r]
-    kinetic = 0.0
-    for i in range(x.shape[0]):
-        kinetic += v[i, 0] * v[i, 0] + v[i, 1] * v[i, 1]
-    parts[ENERGY_KINETIC] = 0.5 * m * kinetic
-    parts[ENERGY_STRETCHING] = stretch_energy(x, model.rest_len[r], model.ea[r])
-    parts[ENERGY_BENDING] = bend_energy(x, model.rest_len[r], model.ei[r], model.rest_turn[r])
-    parts[ENERGY_GAS] = 0.0
-    if model.pressurised[r]:
-        parts[ENERGY_GAS] = gas_energy(
-            polygon_area(x), model.gas_constant[r], model.gas_exponent, model.atmospheric_pressure,
-            model.width[r],
-        )  # fmt: skip
-    parts[ENERGY_GRAVITY] = gravity_energy(x, m, model.gravity) if model.use_gravity else 0.0
-    return parts.sum()
+def free_energy(model, r, x, v, parts, out):
+    """``out[ENERGY_TOTAL]`` = the energy (J) of ring ``r``; ``out[ENERGY_FREE]`` = its free part:
+    kinetic plus elastic and gas energy above the inflated circle at rest (``Model.rest_energy``),
+    gravity left out. Other columns of ``out`` are left alone."""
+    out[ENERGY_TOTAL] = ring_energy(model, r, x, v, parts)
+    g = gravity_column(model)
+    out[ENERGY_FREE] = out[ENERGY_TOTAL] - (parts[g] if g >= 0 else 0.0) - model.rest_energy[r]
+
+
+@njit(cache=True)
+def energy_grew(total_before, free_before, total_after, free_after):
+    """True if a step from energy ``total_before`` to ``total_after`` (J; ``free_``: their free
+    parts, see :func:`free_energy`) raised the total by more than ``ENERGY_GROWTH_TOL`` times the
+    mean free energy, or gave a non-finite energy."""
+    if not math.isfinite(total_after):
+        return True
+    free = max(0.5 * (free_before + free_after), 0.0)
+    return total_after - total_before > ENERGY_GROWTH_TOL * free + 1e-12 * abs(total_before)
+
+
+@njit(cache=True)
+def _energy_scale(model, r, x, parts):
+    """Size (J) of the terms that make up ring ``r``'s energy, for round-off tolerances: the sum of
+    |energy parts| ``parts`` (5,), with gravity's part taken node by node, ``m |g_d x_i,d|`` summed
+    (the ring's gravity energy can cancel to nearly 0 while its nodes' terms do not)."""
+    scale = 0.0
+    g = gravity_column(model)
+    for k in range(parts.shape[0]):
+        if k != g:
+            scale += abs(parts[k])
+    if model.use_gravity:
+        for i in range(x.shape[0]):
+            for d in range(2):
+                scale += model.node_mass[r] * abs(model.gravity[d] * x[i, d])
+    return scale
+
+
+@njit(cache=True)
+def within_energy_budget(model, r, before, kick, trial, ws):
+    """Hold ring ``r``'s energy after a trial step to its budget ``trial.energy[r, ENERGY_BUDGET]``
+    (J): its energy at the start of the run plus what actuation and collision impulses gave it
+    since. Nothing else in a scene adds energy: the gas and gravity are potentials; damping,
+    friction and the ground's constraints only remove it. ``before`` is the ring's carried energy
+    row before the step, ``kick`` the kinetic energy the step's collision impulses gave it.
+
+    A gain of the step above ``ENERGY_GROWTH_TOL`` times the mean free energy is a spurious solution
+    (far too large implicit steps of a nonlinear ring converge to some): returns False, the step is
+    rejected and retried smaller. Smaller gains are the integrator's truncation error
+    (generalized-alpha is not energy-stable for a nonlinear ring: the energy of a spinning ring
+    oscillates by about ``h^2.5``); whatever of it lifts the energy above the budget is removed from
+    the ring's velocities relative to its centre of mass, keeping its momentum
+    (:func:`energy.remove_internal_kinetic_energy`), ``trial.energy[r]`` is recomputed and the
+    removal is tallied in ``ws.energy_tally``; ground-constrained nodes are then put back at rest
+    in their ground's normal direction (which only lowers the energy further). If the ring's spin
+    and deformation hold too little kinetic energy to pay the excess (a ring in rigid translation),
+    an excess within round-off (1e-12 of :func:`_energy_scale`) is accepted as it is and a larger
+    one returns False. ``ws.energy`` must hold the energy parts of the trial state (as
+    :func:`free_energy` leaves them)."""
+    after = trial.energy[r]
+    if energy_grew(
+        before[ENERGY_TOTAL] + kick, before[ENERGY_FREE] + kick, after[ENERGY_TOTAL], after[ENERGY_FREE]
+    ):
+        return False
+    excess = after[ENERGY_TOTAL] - after[ENERGY_BUDGET]
+    if excess <= 0.0:
+        return True
+    if not remove_internal_kinetic_energy(trial.x[r], trial.v[r], model.node_mass[r], excess):
+        return excess <= 1e-12 * _energy_scale(model, r, trial.x[r], ws.energy)
+    rest_on_grounds(model.grounds, trial.active[r], trial.v[r], trial.a[r])
+    free_energy(model, r, trial.x[r], trial.v[r], ws.energy, after)
+    ws.energy_tally[TALLY_PROJECTED] += 1.0
+    ws.energy_tally[TALLY_REMOVED] += excess
+    return True
 
 
 @njit(cache=True)

@@ -1,7 +1,7 @@
 """Events located inside an accepted step: touchdown, lift-off and apex.
 
-Rows of the event buffer: ``(t (s), ring, kind, centre-of-mass height (m))`` with kind
-0 = touchdown, 1 = liftoff, 2 = apex.
+Rows of the event buffer: ``(t (s), ring, kind, centre-of-mass height (m))`` (``layout.EVENT``) with
+kind ``layout.EVENT_KINDS`` (0 = touchdown, 1 = liftoff, 2 = apex).
 
 * apex: the vertical centre-of-mass velocity changes sign from up to down within the step; its time
   by linear interpolation of that velocity, its height by the cubic Hermite interpolant of the
@@ -16,12 +16,10 @@ import numpy as np
 from numba import njit
 
 from .contact import FREE, deepest_ground
-from .loads import centre_of_mass
+from .geometry import centre_of_mass
+from .layout import EVENT_APEX, EVENT_KINDS, EVENT_LIFTOFF, EVENT_TOUCHDOWN
 
-EVENT_TOUCHDOWN = 0
-EVENT_LIFTOFF = 1
-EVENT_APEX = 2
-EVENT_KINDS = ("touchdown", "liftoff", "apex")
+__all__ = ["EVENT_APEX", "EVENT_KINDS", "EVENT_LIFTOFF", "EVENT_TOUCHDOWN", "detect_events", "event_list"]
 
 
 @njit(cache=True)

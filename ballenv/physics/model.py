@@ -1,7 +1,8 @@
 """Compile a :class:`Scene` into the flat arrays the stepper works on (data flows one way).
 
-``Model`` holds the physics (per-ring arrays of length R and scene scalars), ``Solver`` the numerical
-method, ``Workspace`` the scratch arrays of one ring's Newton solve. All are NamedTuples of NumPy
+``Model`` holds the physics (per-ring arrays of length R and scene scalars), ``State`` what the
+stepper carries from step to step, ``Workspace`` the scratch arrays of one ring's Newton solve
+(``integrator.Solver`` holds the numerical method). All are NamedTuples of NumPy
 arrays and scalars: numba compiles them as records, they pickle, and they hold nothing else.
 """
 
@@ -9,15 +10,22 @@ import math
 from typing import NamedTuple
 
 import numpy as np
+from numba import types
+from numba.extending import overload
 
 from . import ring as ring_geometry
+from .assembly import (
+    effect_modules,
+    energy_parts,
+    field_name,
+    parameter_table,
+    ring_energy,
+)
 from .collision import CONTACT_COLUMNS, CONTACTS_PER_NODE
-from .energy import ENERGY_GRAVITY, ENERGY_PARTS, ring_energy
+from .effects import EFFECTS
+from .effects.damping import DAMPING_CENTRE_OF_MASS, DAMPING_NONE, DAMPING_RIGID
+from .layout import ENERGY, TALLY
 from .linalg import BAND_COLUMNS, MAX_LOW_RANK, zigzag_positions
-from .loads import DAMPING_CENTRE_OF_MASS, DAMPING_NONE, DAMPING_RIGID
-
-METHOD_BACKWARD_EULER = 0
-METHOD_GENERALIZED_ALPHA = 1
 
 CONTACT_NONE = 0
 CONTACT_MASS_MODIFICATION = 1
@@ -48,20 +56,14 @@ class Model(NamedTuple):
     thickness: np.ndarray  # (R,) m: wall thickness (the contact distance of two rings is h_a + h_b)
     collide: bool  # ring-ring collision (two or more rings and Scene.ring_collision)
     reject_self_intersection: bool  # reject trial states in which a ring crosses itself
+    effect_parameters: np.ndarray  # (R,) records: one field per effect summed, its own parameters
 
 
-class Solver(NamedTuple):
-    method: int
-    alpha_m: float
-    alpha_f: float
-    beta: float
-    gamma: float
-    newton_tol: float  # residual relative to the forces it balances
-    newton_max_iter: int
-    dt: float  # s
-    dt_min: float  # s
-    adaptive: bool
-    growth: float
+# Model fields with one entry per ring (the rest are scene-wide): a view of rings [a, b) slices these
+PER_RING_FIELDS = (
+    "node_mass", "ea", "ei", "rest_len", "rest_turn", "width", "radius", "pressurised", "gas_constant",
+    "rest_energy", "thickness", "effect_parameters",
+)  # fmt: skip
 
 
 class CollisionWorkspace(NamedTuple):
@@ -95,8 +97,8 @@ class Workspace(NamedTuple):
     ve: np.ndarray  # (N, 2)
     reaction: np.ndarray  # (N,) normal ground reaction of the last solve (N)
     friction: np.ndarray  # (N,) friction force along the ground's tangent (N)
-    energy: np.ndarray  # (5,) energy parts (J)
-    energy_tally: np.ndarray  # (3,) what the last trial step's energy budget saw (stepper.TALLY_*)
+    energy: np.ndarray  # (P,) energy parts (J), columns assembly.energy_parts of the model's effects
+    energy_tally: np.ndarray  # (TALLY.size,) what the last trial step's energy budget saw (layout.TALLY)
     collision: CollisionWorkspace
 
 
@@ -106,7 +108,7 @@ class State(NamedTuple):
     a: np.ndarray  # (R, N, 2) m/s^2 (the generalized-alpha acceleration)
     active: np.ndarray  # (R, N) int64: constraining ground of each node, or -1
     contact_force: np.ndarray  # (R, N, 2) N
-    energy: np.ndarray  # (R, 3) J: each ring's energy, its free part and its budget (stepper.ENERGY_*)
+    energy: np.ndarray  # (R, ENERGY.size) J: each ring's energy, its free part and its budget (layout.ENERGY)
 
 
 class Recording(NamedTuple):
@@ -118,23 +120,11 @@ class Recording(NamedTuple):
     events: np.ndarray  # (E, 4): t, ring, kind, centre-of-mass height
 
 
-def generalized_alpha_parameters(rho_infinity):
-    """Chung-Hulbert parameters ``(alpha_m, alpha_f, beta, gamma)`` for a spectral radius rho_inf.
-
-    ``alpha_m = (2 rho - 1) / (rho + 1)``, ``alpha_f = rho / (rho + 1)``,
-    ``gamma = 1/2 - alpha_m + alpha_f``, ``beta = (1 - alpha_m + alpha_f)^2 / 4``: second order,
-    unconditionally stable, high-frequency damping set by ``rho`` (1: none).
-    """
-    r = float(rho_infinity)
-    alpha_m = (2.0 * r - 1.0) / (r + 1.0)
-    alpha_f = r / (r + 1.0)
-    gamma = 0.5 - alpha_m + alpha_f
-    beta = 0.25 * (1.0 - alpha_m + alpha_f) ** 2
-    return alpha_m, alpha_f, beta, gamma
-
-
-def build_model(scene):
-    """Per-ring arrays and scene scalars of ``scene``."""
+def build_model(scene, effects=EFFECTS):
+    """Per-ring arrays and scene scalars of ``scene`` for the forces of ``effects`` (the registry by
+    default; :func:`assembly.check_effects` checks that their low-rank Jacobian columns fit
+    ``linalg.MAX_LOW_RANK``), with their own parameters (``effect_parameters``, whose record dtype
+    names the effects: see :mod:`.assembly`)."""
     rings = scene.rings
     n = rings[0].n_nodes
     p_atm = scene.atmospheric_pressure
@@ -179,6 +169,7 @@ def build_model(scene):
         thickness=np.array([r.thickness for r in rings]),
         collide=len(rings) > 1 and scene.ring_collision,
         reject_self_intersection=scene.self_intersection == "reject",
+        effect_parameters=effect_parameters(scene, effects),
     )
     _fill_rest_energy(model, rings)
     return model
@@ -187,10 +178,22 @@ def build_model(scene):
 def _fill_rest_energy(model, rings):
     """``model.rest_energy[r]``: energy (J) of ring ``r`` on its inflated circle at rest, gravity
     left out: the floor of its potential energy (a regular polygon has no bending energy)."""
-    parts = np.zeros(len(ENERGY_PARTS))
+    names = energy_parts(effect_modules(model.effect_parameters))
+    parts = np.zeros(len(names))
     for r, ring in enumerate(rings):
         x, _ = ring_geometry.initial_nodes(ring)
-        model.rest_energy[r] = ring_energy(model, r, x, np.zeros_like(x), parts) - parts[ENERGY_GRAVITY]
+        total = ring_energy(model, r, x, np.zeros_like(x), parts)
+        model.rest_energy[r] = total - (parts[names.index("gravity")] if "gravity" in names else 0.0)
+
+
+def effect_parameters(scene, effects=EFFECTS):
+    """(R,) records of the effects' own per-ring parameters (see ``effects``' contract)."""
+    table = parameter_table(effects, len(scene.rings))
+    for k, effect in enumerate(effects):
+        if effect.PARAMETERS:
+            for r, ring in enumerate(scene.rings):
+                table[field_name(k, effect)][r] = effect.parameters(scene, ring)
+    return table
 
 
 def ground_array(grounds):
@@ -203,33 +206,9 @@ def ground_array(grounds):
     return out
 
 
-def build_solver(scene):
-    """Integrator coefficients and step control of ``scene``."""
-    if scene.integrator == "backward_euler":
-        method = METHOD_BACKWARD_EULER
-        alpha_m = alpha_f = 0.0
-        beta = gamma = 1.0
-    else:
-        method = METHOD_GENERALIZED_ALPHA
-        alpha_m, alpha_f, beta, gamma = generalized_alpha_parameters(scene.rho_infinity)
-    return Solver(
-        method=method,
-        alpha_m=alpha_m,
-        alpha_f=alpha_f,
-        beta=beta,
-        gamma=gamma,
-        newton_tol=float(scene.newton_tol),
-        newton_max_iter=int(scene.newton_max_iter),
-        dt=float(scene.dt),
-        dt_min=float(scene.dt_min),
-        adaptive=bool(scene.adaptive),
-        growth=1.25,
-    )
-
-
-def build_workspace(n_nodes, n_rings=1):
+def build_workspace(n_nodes, n_rings=1, effects=EFFECTS):
     """Scratch arrays for one ring's Newton solve and the scene's collision detection, allocated
-    once per simulation."""
+    once per simulation (``effects``: the model's, for the size of the energy table)."""
     n2 = 2 * n_nodes
     return Workspace(
         pos=zigzag_positions(n_nodes),
@@ -247,8 +226,8 @@ def build_workspace(n_nodes, n_rings=1):
         ve=np.zeros((n_nodes, 2)),
         reaction=np.zeros(n_nodes),
         friction=np.zeros(n_nodes),
-        energy=np.zeros(5),
-        energy_tally=np.zeros(3),
+        energy=np.zeros(len(energy_parts(effects))),
+        energy_tally=np.zeros(TALLY.size),
         collision=build_collision_workspace(n_rings, n_nodes),
     )
 
@@ -278,7 +257,7 @@ def empty_state(n_rings, n_nodes):
         a=np.zeros(shape),
         active=np.full((n_rings, n_nodes), -1, dtype=np.int64),
         contact_force=np.zeros(shape),
-        energy=np.zeros((n_rings, 3)),
+        energy=np.zeros((n_rings, ENERGY.size)),
     )
 
 
@@ -293,3 +272,25 @@ def empty_recording(capacity, n_rings, n_nodes, event_capacity):
         contact_force=np.empty(shape),
         events=np.empty((event_capacity, 4)),
     )
+
+
+def rings_view(record, start, stop):
+    """``record`` (a :class:`Model` or :class:`State`) restricted to rings ``[start, stop)``: views of
+    its per-ring fields (``PER_RING_FIELDS`` of a Model, every field of a State), the rest shared.
+    Compiled from the field lists, so a field added to a record is sliced or shared by name."""
+
+
+def _per_ring_fields(cls):
+    return PER_RING_FIELDS if cls is Model else cls._fields
+
+
+@overload(rings_view)
+def _rings_view(record, start, stop):
+    if not isinstance(record, types.BaseNamedTuple) or record.instance_class not in (Model, State):
+        return None
+    cls = record.instance_class
+    sliced = _per_ring_fields(cls)
+    args = ", ".join(f"record.{f}[start:stop]" if f in sliced else f"record.{f}" for f in cls._fields)
+    scope = {"cls": cls}
+    exec(f"def impl(record, start, stop):\n    return cls({args})", scope)  # noqa: S102 - fields only
+    return scope["impl"]

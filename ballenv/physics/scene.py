@@ -10,6 +10,8 @@ import math
 from dataclasses import dataclass, field
 from numbers import Integral, Real
 
+from .effects import scene_effects
+
 INTEGRATORS = ("backward_euler", "generalized_alpha")
 DAMPING_MODES = ("rigid", "centre_of_mass")
 CONTACT_METHODS = ("mass_modification", "predictor_corrector")
@@ -199,8 +201,10 @@ class Scene:
         rho_infinity: spectral radius at infinite frequency of generalized-alpha, in [0, 1]
             (1 = no numerical damping, trapezoidal rule; 0 = strongest high-frequency damping).
         dt: time step (s) in (0, 1]: the fixed step, or the largest step when adaptive.
-        adaptive: adapt the step: a step whose Newton iteration fails is rejected and retried with
-            half the step; accepted steps grow it cautiously (x1.25) back up to ``dt``.
+        adaptive: adapt the step to the contact impulse: a step whose impulse exceeds
+            ``impulse_tol`` is rejected and shrunk by the ratio, accepted steps grow it cautiously
+            (x1.25) back up to ``dt``. False: fixed steps ``dt``. Either way a rejected step (Newton
+            failure, energy gain, intrusion, self-intersection) is retried with half the step.
         dt_min: smallest step (s) before simulate() gives up with SimulationError, in (0, dt].
         newton_tol: Newton tolerance on the residual relative to the forces it balances
             (dimensionless), in [1e-14, 1e-2].
@@ -289,18 +293,6 @@ class Scene:
 
     @property
     def effects(self):
-        """Names of the effects this scene switches on (stretching and bending always are)."""
-        names = ["stretching", "bending"]
-        if any(r.pressure is not None for r in self.rings):
-            names.append("pressure")
-        if any(g != 0.0 for g in self.gravity_vector):
-            names.append("gravity")
-        if self.damping > 0.0:
-            names.append("damping")
-        if self.grounds:
-            names.append("ground")
-            if any(g.friction > 0.0 for g in self.grounds):
-                names.append("friction")
-        if len(self.rings) > 1 and self.ring_collision:
-            names.append("ring_collision")
-        return tuple(names)
+        """Names of the effects this scene switches on (stretching and bending always are), from the
+        registry ``ballenv.physics.effects``."""
+        return scene_effects(self)

@@ -94,7 +94,7 @@ def save(traj, path):
 def load(path):
     """Read a trajectory written by :func:`save`; a missing or foreign file raises ValueError
     (FileNotFoundError if it does not exist)."""
-    from .simulate import SimulationStats, Trajectory
+    from .simulation import SimulationStats, Trajectory
 
     path = pathlib.Path(path)
     if not path.exists():

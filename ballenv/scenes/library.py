@@ -12,7 +12,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..physics import Ground, Ring, Scene, Trajectory, simulate
+from ..physics import Ground, Ring, Scene, Simulation, SimulationError, simulate
+from ..physics.events import event_list
 from ..physics.presets import with_fidelity
 from ..physics.ring import bending_stiffness, inflated_radius, total_mass
 
@@ -291,92 +292,47 @@ def rolling(fidelity="balanced", reduced=False, progress=False):
 # ---------------------------------------------------------------- variable inflation
 
 
-def _concatenate(parts, scene):
-    """One trajectory of consecutive ``parts`` (their times already shifted), on ``scene``."""
-    table = np.concatenate([p.event_table for p in parts if p.event_table is not None and len(p.event_table)])
-    from ..physics.events import event_list
-    from ..physics.simulate import SimulationStats
-
-    s = [p.stats for p in parts]
-    stats = SimulationStats(
-        steps=sum(x.steps for x in s),
-        rejected_steps=sum(x.rejected_steps for x in s),
-        newton_iterations=sum(x.newton_iterations for x in s),
-        wall_time=sum(x.wall_time for x in s),
-        effects=s[0].effects,
-        integrator=s[0].integrator,
-        rejections={k: sum(x.rejections.get(k, 0) for x in s) for k in s[0].rejections},
-        energy_projected=sum(x.energy_projected for x in s),
-        energy_removed=sum(x.energy_removed for x in s),
-        collision_gain=sum(x.collision_gain for x in s),
-    )
-    return Trajectory(
-        t=np.concatenate([p.t for p in parts]),
-        x=np.concatenate([p.x for p in parts]),
-        v=np.concatenate([p.v for p in parts]),
-        pressure=np.concatenate([p.pressure for p in parts]),
-        contact_force=np.concatenate([p.contact_force for p in parts]),
-        events=event_list(table),
-        stats=stats,
-        scene=scene,
-        event_table=table,
-    )
+def _advance_to_flight_apex(sim, t_end, interval):
+    """Advance ``sim`` in steps of ``interval`` (s) until the first apex after a lift-off (True) or
+    ``t_end`` (s) (False); raises SimulationError if the run fails."""
+    seen = sim.event_count
+    lifted = False
+    while sim.t < t_end - 1e-12:
+        if not sim.advance(min(t_end, (round(sim.t / interval) + 1) * interval)):
+            raise SimulationError(sim.failure, sim.trajectory())
+        for _, _, kind in event_list(sim.event_rows(seen)):
+            lifted = lifted or kind == "liftoff"
+            if kind == "apex" and lifted:
+                return True
+        seen = sim.event_count
+    return False
 
 
 def pumped_bounces(schedule, fidelity, progress, ring_kw, damping, output_dt=1e-3):
-    """A ring bounced on flat ground whose gas is set, at each apex, to the next amount of
-    ``schedule`` (gauge pressures at rest, Pa): between bounces the simulation restarts from the
-    state at the apex with the new gas amount (as :func:`ballenv.physics.actuation.set_rest_pressure`
-    does). Returns one :class:`Trajectory` (the first stage's scene) and the switch times (s)."""
-    x0 = v0 = None
-    t0 = 0.0
-    parts, switches = [], []
-    first_scene = None
-    for k, p in enumerate(schedule):
-        scene = with_fidelity(
-            Scene(rings=[Ring(pressure=p, **ring_kw)], grounds=[Ground(friction=0.5)], damping=damping),
-            fidelity,
-        )
-        first_scene = first_scene or scene
-        height = ring_kw["position"][1] if x0 is None else float(x0[..., 1].mean())
-        t_stage = 2.0 * math.sqrt(2.0 * max(height, 0.05) / G) + 0.15
-        part = simulate(scene, t_stage, x0=x0, v0=v0, output_dt=output_dt, progress=progress)
-        lift = first_event(part, "liftoff")
-        apex = first_event(part, "apex", after=lift) if lift is not None else None
-        last = k == len(schedule) - 1
-        if apex is None or last:
-            cut = len(part.t)
-        else:
-            cut = int(np.searchsorted(part.t, apex)) + 1
-        rows = part.event_table[part.event_table[:, 0] < (part.t[cut - 1] + 1e-12)].copy()
-        rows[:, 0] += t0
-        piece = Trajectory(
-            t=part.t[:cut] + t0,
-            x=part.x[:cut],
-            v=part.v[:cut],
-            pressure=part.pressure[:cut],
-            contact_force=part.contact_force[:cut],
-            events=[],
-            stats=part.stats,
-            scene=scene,
-            event_table=rows,
-        )
-        parts.append(piece)
-        if apex is None or last:
+    """A ring bounced on flat ground whose gas is set, at each apex in flight, to the next amount of
+    ``schedule`` (gauge pressures at rest, Pa) with :meth:`Simulation.set_rest_pressure`, as the
+    env's pump does: one continuous run. Each stage lasts until its first apex after a lift-off, at
+    most two free-fall times from its start height plus 0.15 s (the last stage: all of that).
+    Returns its :class:`Trajectory` (the first stage's scene) and the switch times (s)."""
+    scene = with_fidelity(
+        Scene(rings=[Ring(pressure=schedule[0], **ring_kw)], grounds=[Ground(friction=0.5)], damping=damping),
+        fidelity,
+    )
+    sim = Simulation(scene, output_dt=output_dt)
+    switches = []
+    for k, pressure in enumerate(schedule):
+        if k and pressure != schedule[k - 1]:
+            sim.set_rest_pressure(0, pressure)
+        if k:
+            switches.append(sim.t)
+        height = float(sim.state.x[0, :, 1].mean())
+        t_stage = sim.t + 2.0 * math.sqrt(2.0 * max(height, 0.05) / G) + 0.15
+        if k == len(schedule) - 1:
+            if not sim.advance(t_stage, progress):
+                raise SimulationError(sim.failure, sim.trajectory())
+        elif not _advance_to_flight_apex(sim, t_stage, output_dt):
             break
-        x0, v0 = part.x[cut - 1], part.v[cut - 1]
-        t0 += part.t[cut - 1]
-        switches.append(t0)
-        # the restart's first record repeats the cut state: drop it from the next part
-        parts[-1] = dataclasses.replace(
-            piece,
-            t=piece.t[:-1],
-            x=piece.x[:-1],
-            v=piece.v[:-1],
-            pressure=piece.pressure[:-1],
-            contact_force=piece.contact_force[:-1],
-        )
-    return _concatenate(parts, first_scene), switches
+    return sim.trajectory(), switches
 
 
 def variable_inflation(fidelity="balanced", reduced=False, progress=False):

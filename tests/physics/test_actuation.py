@@ -5,10 +5,14 @@ import pytest
 
 from ballenv.physics import Ground, Ring, Scene
 from ballenv.physics.actuation import apply_impulse, rest_circle_radius, set_rest_pressure
-from ballenv.physics.model import build_model, build_solver, build_workspace, empty_state
+from ballenv.physics.assembly import ring_force
+from ballenv.physics.effects.gas import ring_pressure
+from ballenv.physics.energy import free_energy
+from ballenv.physics.integrator import build_solver
+from ballenv.physics.model import build_model, build_workspace, empty_state
 from ballenv.physics.ring import inflated_radius, total_mass
-from ballenv.physics.simulate import initial_state
-from ballenv.physics.stepper import free_energy, initial_state_values, ring_force, ring_pressure
+from ballenv.physics.simulation import initial_state
+from ballenv.physics.stepper import initial_state_values
 
 
 def _ring_state(scene):

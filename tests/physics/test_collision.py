@@ -1,5 +1,5 @@
 """Ring-ring collision and self-intersection: detection against brute force and geometry, and the
-collision scenes of the issue (head-on, a ball dropped on a resting ball, eight balls in a box)."""
+collision scenes (head-on, a ball dropped on a resting ball, eight balls in a box)."""
 
 import math
 

@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from ballenv.physics.assembly import ring_jacobian
 from ballenv.physics.linalg import (
     BAND_COLUMNS,
     BAND_HALF_WIDTH,
@@ -14,7 +15,6 @@ from ballenv.physics.linalg import (
 )
 from ballenv.physics.model import build_model, build_workspace
 from ballenv.physics.scene import Ring, Scene
-from ballenv.physics.stepper import ring_jacobian
 
 from .conftest import deformed_ring
 

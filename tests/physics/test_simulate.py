@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from ballenv.physics import Ring, Scene, SimulationError, energy, simulate
-from ballenv.physics.loads import polygon_area
+from ballenv.physics.geometry import polygon_area
 from ballenv.physics.ring import inflated_radius
 
 E, RHO, R = 10e6, 1100.0, 0.1

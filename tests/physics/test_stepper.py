@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 from ballenv.physics import Ground, Ring, Scene, simulate
+from ballenv.physics.energy import energy_grew, free_energy
 from ballenv.physics.model import build_model
-from ballenv.physics.simulate import initial_state
-from ballenv.physics.stepper import _energy_grew, free_energy
+from ballenv.physics.simulation import initial_state
 
 
 def _first_apex(**scene_kw):
@@ -56,10 +56,10 @@ def test_energy_guard_flags_a_step_that_adds_energy():
     free_energy(model, 0, x[0], moving, parts, kicked)
     free_energy(model, 0, x[0], np.full_like(moving, np.nan), parts, broken)
     assert at_rest[1] == pytest.approx(0.0, abs=1e-12 * at_rest[0])  # the inflated circle is the rest state
-    assert not _energy_grew(*at_rest, *at_rest)
-    assert _energy_grew(*at_rest, *kicked)
-    assert not _energy_grew(*kicked, *at_rest)
-    assert _energy_grew(*at_rest, *broken)
+    assert not energy_grew(*at_rest, *at_rest)
+    assert energy_grew(*at_rest, *kicked)
+    assert not energy_grew(*kicked, *at_rest)
+    assert energy_grew(*at_rest, *broken)
 
 
 def test_friction_on_arriving_nodes_does_not_stall_newton():

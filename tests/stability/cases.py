@@ -1,5 +1,5 @@
-"""The named hard cases of the stability suite (issue 8), each a scene, an end time and optionally a
-start state; every case is run with both contact methods and both integrators.
+"""The named hard cases of the stability suite, each a scene, an end time and optionally a start
+state; every case is run with both contact methods and both integrators.
 
 All use SI units. Unless a case says otherwise: a ring of radius 0.1 m, N = 32, E = 10 MPa,
 h = 2 mm, b = 2 cm, rho = 1100 kg/m^3, 30 kPa, on flat ground with friction 0.5, adaptive steps up

@@ -13,7 +13,7 @@ import numpy as np
 from ballenv.physics import simulate
 from ballenv.physics.collision import find_contacts
 from ballenv.physics.model import build_collision_workspace, ground_array
-from ballenv.physics.simulate import SimulationError
+from ballenv.physics.simulation import SimulationError
 
 GROUND_TOLERANCE = 1e-6  # m: deepest a node may be below a ground in an accepted state
 ENERGY_ROUND_OFF = 1e-9  # energy growth allowed, relative to the sum of |energy parts| at the start

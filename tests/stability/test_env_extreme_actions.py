@@ -1,4 +1,4 @@
-"""Issue 8: the largest actions of both action modes every step for 10,000 env steps (100 s of
+"""Stability suite: the largest actions of both action modes every step for 10,000 env steps (100 s of
 simulated time at 100 Hz, through about ten resets): observations finite and inside the observation
 space, rewards finite, the ball never below the ground by more than 1e-6 m, and no simulator
 failure. The default run uses the env's own settings (the fast preset: generalized-alpha,

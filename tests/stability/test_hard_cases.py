@@ -1,4 +1,4 @@
-"""Issue 8: the named hard cases, each with both contact methods and both integrators.
+"""Stability suite: the named hard cases, each with both contact methods and both integrators.
 
 For every run: every accepted state finite, no node below a ground by more than
 ``GROUND_TOLERANCE`` (1e-6 m) and none inside another ring, the total energy (kinetic + elastic +
@@ -14,8 +14,10 @@ import numpy as np
 import pytest
 
 from ballenv.physics import Ground, Ring, Scene, SimulationError, simulate
-from ballenv.physics.model import build_model, build_solver, build_workspace, empty_state
-from ballenv.physics.stepper import REJECT_NEWTON, initial_state_values, try_step
+from ballenv.physics.integrator import build_solver
+from ballenv.physics.layout import REJECT_NEWTON
+from ballenv.physics.model import build_model, build_workspace, empty_state
+from ballenv.physics.stepper import initial_state_values, try_step
 
 from .cases import CONTACTS, INTEGRATORS, hard_cases, released_flat
 from .invariants import audit
@@ -35,7 +37,7 @@ def test_hard_case_is_stable(name, contact, integrator):
 
 
 def test_the_cases_are_as_hard_as_named():
-    """The scenes reach the extremes the issue names."""
+    """The scenes reach the extremes their names claim."""
     flat = CASES["squashed_flat"]
     height = np.ptp(flat.x0[:, 1])
     assert height <= 0.1 * 2 * flat.scene.rings[0].radius + 1e-3  # walls 1 cm apart, 20 cm ball
@@ -78,7 +80,7 @@ def test_a_failed_newton_iteration_is_rejected_and_leaves_the_state_untouched():
     scene, v0 = _violent_ring(dt=5e-3, newton_max_iter=1)
     model, solver, ws = build_model(scene), build_solver(scene), build_workspace(32)
     state, trial = empty_state(1, 32), empty_state(1, 32)
-    from ballenv.physics.simulate import initial_state
+    from ballenv.physics.simulation import initial_state
 
     state.x[:] = initial_state(scene)[0]
     state.v[:] = v0
@@ -157,7 +159,7 @@ def test_a_newton_iterate_turned_inside_out_is_taken_back_not_a_crash():
     ring hitting the ground at 37 m/s gave a Newton iterate of zero area; the gas law divided by
     A^k = 0 and numba raised ZeroDivisionError out of simulate(). The gas kernels now return NaN
     for A <= 0, which the Newton loop takes back (backtracking) or rejects."""
-    from ballenv.physics.loads import gas_energy, gas_pressure, gas_pressure_slope
+    from ballenv.physics.effects.gas import gas_energy, gas_pressure, gas_pressure_slope
 
     for area in (0.0, -1e-3):
         assert math.isnan(gas_pressure(area, 1e3, 1.4, 0.0))

@@ -1,4 +1,4 @@
-"""Issue 8, property-based (hypothesis): random valid scenes and action sequences run stable, and
+"""Stability suite, property-based (hypothesis): random valid scenes and action sequences run stable, and
 random invalid values (NaN, inf, negative, out of range, wrong shapes and types) raise ValueError
 naming the field and the valid range. Seeded (``derandomize``): the same examples on every run;
 ``benchmarks/soak.py`` runs thousands of fresh ones."""

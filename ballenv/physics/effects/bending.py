@@ -1,83 +1,53 @@
-"""Stretching and bending of a closed discrete elastic rod (a ring), with exact Jacobians.
+"""Bending of the ring's wall: a discrete elastic rod's turning angles, stiffness EI (N m^2).
 
-Nodes ``x`` (N, 2) in metres, counter-clockwise; edge ``e_i = x_{i+1} - x_i`` (indices mod N).
+Per node, with the turning angle ``phi_i`` between edges ``e_{i-1}`` and ``e_i``::
 
-Stretching, per edge::
+    E_b = 1/2 (EI / l0) (phi_i - phi0)^2,   phi0 = 2 pi / N (the circle)                [J]
 
-    E_s = 1/2 EA eps^2 l0,   eps = |e| / l0 - 1                      [J per metre of width * b]
-
-Bending, per node, with the turning angle ``phi_i`` between edges ``e_{i-1}`` and ``e_i``::
-
-    E_b = 1/2 (EI / l0) (phi_i - phi0)^2,   phi0 = 2 pi / N (the circle)
-
-``EA = E b h`` (N) and ``EI = E b h^3 / 12`` (N m^2). Forces are ``F = -dE/dx`` (N); Jacobian kernels
-add ``coef * dF/dx`` (N/m) into a band matrix (see :mod:`ballenv.physics.linalg`).
+``EI = E b h^3 / 12`` (N m^2). Force ``F = -dE_b/dx`` (N); the Jacobian couples each node with two
+neighbours on each side (band half-width 2 nodes), exact. Always on.
 """
 
 import math
 
 from numba import njit
 
-from .cyclic import next_node, prev_node
-from .linalg import band_add_block
+from ..cyclic import next_node, prev_node
+from ..linalg import band_add_block
+
+NAME = "bending"
+ENERGY_PART = "bending"
+LOW_RANK = 0
+PARAMETERS = ()
 
 
-@njit(cache=True)
-def stretch_energy(x, rest_len, ea):
-    """Stretching energy (J) of the ring."""
-    n = x.shape[0]
-    e = 0.0
-    for i in range(n):
-        j = next_node(i, n)
-        dx = x[j, 0] - x[i, 0]
-        dy = x[j, 1] - x[i, 1]
-        eps = math.sqrt(dx * dx + dy * dy) / rest_len - 1.0
-        e += 0.5 * ea * eps * eps * rest_len
-    return e
+def enabled(scene):
+    """Every ring bends."""
+    return True
 
 
-@njit(cache=True)
-def stretch_force(x, rest_len, ea, f):
-    """Add the stretching forces (N) to ``f`` (N, 2)."""
-    n = x.shape[0]
-    for i in range(n):
-        j = next_node(i, n)
-        dx = x[j, 0] - x[i, 0]
-        dy = x[j, 1] - x[i, 1]
-        length = math.sqrt(dx * dx + dy * dy)
-        eps = length / rest_len - 1.0
-        s = ea * eps / length
-        f[i, 0] += s * dx
-        f[i, 1] += s * dy
-        f[j, 0] -= s * dx
-        f[j, 1] -= s * dy
+@njit(cache=True, inline="always")
+def on(model, p, r):
+    return True
 
 
-@njit(cache=True)
-def stretch_jacobian(x, rest_len, ea, coef, band, pos):
-    """Add ``coef * dF_s/dx`` to ``band``.
+@njit(cache=True, inline="always")
+def force(model, p, r, x, v, f):
+    """Add the bending forces (N) on ring ``r`` to ``f``."""
+    bend_force(x, model.rest_len[r], model.ei[r], model.rest_turn[r], f)
 
-    With ``u = e/|e|``, the Hessian of ``E_s`` in ``e`` is ``H = EA [u u^T / l0 + eps (I - u u^T)/|e|]``;
-    ``dF_i/dx_i = dF_j/dx_j = -H`` and ``dF_i/dx_j = dF_j/dx_i = H``.
-    """
-    n = x.shape[0]
-    for i in range(n):
-        j = next_node(i, n)
-        dx = x[j, 0] - x[i, 0]
-        dy = x[j, 1] - x[i, 1]
-        length = math.sqrt(dx * dx + dy * dy)
-        eps = length / rest_len - 1.0
-        ux = dx / length
-        uy = dy / length
-        a = ea / rest_len
-        b = ea * eps / length
-        h00 = coef * (a * ux * ux + b * (1.0 - ux * ux))
-        h01 = coef * (a * ux * uy - b * ux * uy)
-        h11 = coef * (a * uy * uy + b * (1.0 - uy * uy))
-        band_add_block(band, pos, i, i, -h00, -h01, -h01, -h11)
-        band_add_block(band, pos, j, j, -h00, -h01, -h01, -h11)
-        band_add_block(band, pos, i, j, h00, h01, h01, h11)
-        band_add_block(band, pos, j, i, h00, h01, h01, h11)
+
+@njit(cache=True, inline="always")
+def jacobian(model, p, r, x, v, coef_x, coef_v, ws, rank):
+    """Add ``coef_x dF/dx`` to ``ws.band`` (no velocity dependence, no low-rank part)."""
+    bend_jacobian(x, model.rest_len[r], model.ei[r], model.rest_turn[r], coef_x, ws.band, ws.pos)
+    return rank
+
+
+@njit(cache=True, inline="always")
+def energy(model, p, r, x, v):
+    """Bending energy (J) of ring ``r``."""
+    return bend_energy(x, model.rest_len[r], model.ei[r], model.rest_turn[r])
 
 
 @njit(cache=True)

@@ -3,16 +3,10 @@
 import numpy as np
 import pytest
 
-from ballenv.physics.elastic import (
-    bend_energy,
-    bend_force,
-    bend_jacobian,
-    stretch_energy,
-    stretch_force,
-    stretch_jacobian,
-)
+from ballenv.physics.effects.bending import bend_energy, bend_force, bend_jacobian
+from ballenv.physics.effects.stretching import stretch_energy, stretch_force, stretch_jacobian
 
-from .conftest import (
+from ..conftest import (
     DenseAssembler,
     deformed_ring,
     finite_difference_gradient,

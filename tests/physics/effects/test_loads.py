@@ -3,22 +3,23 @@
 import numpy as np
 import pytest
 
-from ballenv.physics.loads import (
+from ballenv.physics.effects.damping import (
     DAMPING_CENTRE_OF_MASS,
     DAMPING_RIGID,
     damping_force,
     damping_jacobian,
+)
+from ballenv.physics.effects.gas import (
     gas_energy,
     gas_pressure,
     gas_pressure_slope,
-    gravity_energy,
-    gravity_force,
-    polygon_area,
     pressure_force,
     pressure_jacobian,
 )
+from ballenv.physics.effects.gravity import gravity_energy, gravity_force
+from ballenv.physics.geometry import polygon_area
 
-from .conftest import (
+from ..conftest import (
     DenseAssembler,
     deformed_ring,
     finite_difference_gradient,

@@ -1,0 +1,152 @@
+"""The observation vector of InflatedBall-v0, declared once.
+
+:data:`FIELDS` lists the entries of every observation in order, :data:`PADDLE_FIELDS` those that
+paddle mode appends. Everything else is derived from these two tables: the length of the vector
+(:func:`size`), the name -> slice map (:func:`structure`), the float32 bounds the observations are
+clipped to (:func:`bounds`), and the start of each field for the compiled code that writes and reads
+observations (``OBS_*`` and :func:`field_start`: ``row[field_start(OBS_PRESSURE, n)]``).
+
+The ``OBS_*`` constants are frozen into the compiled code of ``batch.py``, whose on-disk numba cache
+is invalidated only by changes to ``batch.py`` itself: after changing a table, clear the
+``__pycache__`` of ``ballenv/envs`` (``tests/envs/test_observation.py`` fails on a stale layout).
+"""
+
+from collections.abc import Callable
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit
+
+MAX_SPEED = 100.0  # m/s, bound of the velocity observations
+MAX_NODE_FORCE = 1e5  # N, bound of the per-node ground normal force observation
+MAX_PRESSURE = 1e7  # Pa, upper bound of the pressure observation
+VACUUM_GAUGE_PRESSURE = -101325.0  # Pa, lower bound of the pressure observation (no gas at all)
+SUNK_HEIGHT = -1.0  # m, lowest centre-of-mass height observed (the simulator has failed below it)
+
+
+class Field(NamedTuple):
+    """One named part of the observation vector: ``per_node * N + fixed`` entries for a ring of N
+    nodes, bounded by ``low(config)`` and ``high(config)`` (a number, or one per entry) in ``unit``;
+    ``config`` is the env's ``BallEnvConfig``."""
+
+    name: str
+    per_node: int
+    fixed: int
+    low: Callable
+    high: Callable
+    unit: str
+    description: str
+
+    def size(self, n_nodes):
+        """Number of entries for a ring of ``n_nodes`` nodes."""
+        return self.per_node * n_nodes + self.fixed
+
+
+def _node_reach(config):
+    """Farthest a node can be from the centre of mass (m): four times the largest inflated radius."""
+    return 4.0 * config.largest_radius()
+
+
+FIELDS = (
+    Field(
+        "node_position", 2, 0, lambda c: -_node_reach(c), _node_reach, "m",
+        "node x, y relative to the centre of mass, interleaved",
+    ),
+    Field(
+        "node_velocity", 2, 0, lambda c: -MAX_SPEED, lambda c: MAX_SPEED, "m/s",
+        "node velocity relative to the centre-of-mass velocity",
+    ),
+    Field(
+        "centre_of_mass_position", 0, 2, lambda c: (-c.arena_half_width, SUNK_HEIGHT),
+        lambda c: (c.arena_half_width, c.arena_height), "m", "x, and height above the ground",
+    ),
+    Field("centre_of_mass_velocity", 0, 2, lambda c: -MAX_SPEED, lambda c: MAX_SPEED, "m/s", "vx, vy"),
+    Field(
+        "ground_normal_force", 1, 0, lambda c: 0.0, lambda c: MAX_NODE_FORCE, "N",
+        "each node's normal ground reaction (0 in flight)",
+    ),
+    Field(
+        "pressure", 0, 1, lambda c: VACUUM_GAUGE_PRESSURE, lambda c: MAX_PRESSURE, "Pa",
+        "current gauge pressure of the gas",
+    ),
+    Field(
+        "target_height", 0, 1, lambda c: c.target_height_range[0], lambda c: c.target_height_range[1], "m",
+        "this episode's target apex height of the centre of mass",
+    ),
+)  # fmt: skip
+
+PADDLE_FIELDS = (
+    Field(
+        "paddle_height", 0, 1, lambda c: 0.0, lambda c: c.arena_height + _node_reach(c), "m",
+        "the paddle's height",
+    ),
+    Field(
+        "paddle_in_reach", 0, 1, lambda c: 0.0, lambda c: 1.0, "-",
+        "1 if the paddle could strike at the last step, else 0",
+    ),
+    Field(
+        "paddle_impulse", 0, 1, lambda c: 0.0, lambda c: c.paddle_max_impulse, "N s",
+        "impulse delivered at the last step",
+    ),
+)  # fmt: skip
+
+
+def _starts(table):
+    """Name -> start of each field of ``table`` as (entries per node, fixed entries) before it."""
+    per_node = fixed = 0
+    out = {}
+    for field in table:
+        out[field.name] = (per_node, fixed)
+        per_node += field.per_node
+        fixed += field.fixed
+    return out
+
+
+_START = _starts(FIELDS + PADDLE_FIELDS)  # paddle mode appends: the other fields start alike in both
+OBS_NODE_POSITION = _START["node_position"]
+OBS_NODE_VELOCITY = _START["node_velocity"]
+OBS_CENTRE_OF_MASS_POSITION = _START["centre_of_mass_position"]
+OBS_CENTRE_OF_MASS_VELOCITY = _START["centre_of_mass_velocity"]
+OBS_GROUND_NORMAL_FORCE = _START["ground_normal_force"]
+OBS_PRESSURE = _START["pressure"]
+OBS_TARGET_HEIGHT = _START["target_height"]
+OBS_PADDLE_HEIGHT = _START["paddle_height"]
+OBS_PADDLE_IN_REACH = _START["paddle_in_reach"]
+OBS_PADDLE_IMPULSE = _START["paddle_impulse"]
+
+
+@njit(cache=True)
+def field_start(field, n_nodes):
+    """Index of the first entry of ``field`` (an ``OBS_*`` constant) for a ring of ``n_nodes`` nodes."""
+    return field[0] * n_nodes + field[1]
+
+
+def fields(paddle):
+    """The fields of the observation in order: :data:`FIELDS`, then :data:`PADDLE_FIELDS` if ``paddle``."""
+    return FIELDS + PADDLE_FIELDS if paddle else FIELDS
+
+
+def size(n_nodes, paddle):
+    """Length of the observation vector for a ring of ``n_nodes`` nodes."""
+    return sum(field.size(n_nodes) for field in fields(paddle))
+
+
+def structure(n_nodes, paddle):
+    """Name -> slice of the observation vector for a ring of ``n_nodes`` nodes."""
+    out = {}
+    for field in fields(paddle):
+        first = field_start(_START[field.name], n_nodes)
+        out[field.name] = slice(first, first + field.size(n_nodes))
+    return out
+
+
+def bounds(config, paddle):
+    """(low, high) float32 bounds of the observation vector of the env configured by ``config``."""
+    n = config.n_nodes
+    parts = structure(n, paddle)
+    low = np.full(size(n, paddle), np.nan)  # a slot no field covers stays NaN
+    high = np.full(size(n, paddle), np.nan)
+    for field in fields(paddle):
+        low[parts[field.name]] = field.low(config)
+        high[parts[field.name]] = field.high(config)
+    return low.astype(np.float32), high.astype(np.float32)

@@ -1,0 +1,115 @@
+"""Integer layouts of the stepper's arrays, each declared once by name.
+
+A :class:`Layout` is an ordered table of named fields, each one or more consecutive slots; its
+indices are plain ints that numba compiles as constants. The module constants below
+(``COUNT_STEPS``, ``CLOCK_T``, ...) are read off these tables, so a new name shifts every later
+index and grows the size with it; ``tests/physics/test_layout.py`` checks that every constant is in
+range and that users (``SimulationStats``, the env's counters) cover the table.
+"""
+
+from collections import OrderedDict
+
+
+class Layout:
+    """Named fields of an integer-indexed array: ``index(name)``, ``slice(name)``, ``size``."""
+
+    def __init__(self, *fields):
+        self._fields = OrderedDict()
+        start = 0
+        for field in fields:
+            name, width = (field, 1) if isinstance(field, str) else field
+            if name in self._fields:
+                raise ValueError(f"layout field {name!r} declared twice")
+            self._fields[name] = (start, width)
+            start += width
+        self.size = start
+
+    @property
+    def names(self):
+        return tuple(self._fields)
+
+    def index(self, name):
+        """First slot of field ``name``."""
+        return self._fields[name][0]
+
+    def slice(self, name):
+        start, width = self._fields[name]
+        return slice(start, start + width)
+
+
+# why a trial step was rejected; the stepper returns minus the code (1, 2, ...)
+REJECTIONS = OrderedDict(
+    newton="Newton's iteration did not converge",
+    energy="the step gained energy (more than the energy budget can take back)",
+    intrusion="a node of one ring ended inside another ring",
+    self_intersection="a ring's wall crossed itself",
+)
+REJECT_NEWTON, REJECT_ENERGY, REJECT_INTRUSION, REJECT_SELF_INTERSECTION = (
+    1 + list(REJECTIONS).index(name) for name in ("newton", "energy", "intrusion", "self_intersection")
+)
+REJECTION_REASONS = {1 + k: text for k, text in enumerate(REJECTIONS.values())}
+
+# what advance() returns
+STATUS = Layout("done", "buffer_full", "step_too_small", "impulse_at_dt_min")
+STATUS_DONE = STATUS.index("done")
+STATUS_BUFFER_FULL = STATUS.index("buffer_full")
+STATUS_STEP_TOO_SMALL = STATUS.index("step_too_small")
+STATUS_IMPULSE_AT_DT_MIN = STATUS.index("impulse_at_dt_min")
+
+# int64 counters of a run
+COUNTERS = Layout(
+    "steps",  # accepted steps
+    "rejected",  # rejected steps, all reasons
+    "newton",  # Newton corrections (linear solves) of accepted steps
+    "grid",  # fixed steps: index of the last grid point reached
+    "records",  # records written
+    "events",  # event rows written
+    "rejection",  # why the last step was rejected: a REJECT_ code
+    ("by_reason", len(REJECTIONS)),  # rejected steps by REJECT_ code (slot code - 1)
+    "impulse_rejected",  # adaptive steps rejected for a contact impulse above impulse_tol
+    "energy_projected",  # accepted (step, ring) pairs whose energy gain was removed
+)
+COUNT_STEPS = COUNTERS.index("steps")
+COUNT_REJECTED = COUNTERS.index("rejected")
+COUNT_NEWTON = COUNTERS.index("newton")
+COUNT_GRID = COUNTERS.index("grid")
+COUNT_RECORDS = COUNTERS.index("records")
+COUNT_EVENTS = COUNTERS.index("events")
+COUNT_REJECTION = COUNTERS.index("rejection")
+COUNT_BY_REASON = COUNTERS.index("by_reason")
+COUNT_IMPULSE_REJECTED = COUNTERS.index("impulse_rejected")
+COUNT_ENERGY_PROJECTED = COUNTERS.index("energy_projected")
+N_COUNTERS = COUNTERS.size
+
+# float64 clock of a run
+CLOCK = Layout(
+    "t",  # time (s)
+    "h",  # current step size (s)
+    "energy_removed",  # energy removed by the energy budget so far (J)
+    "collision_gain",  # energy collision impulses created so far (J)
+)
+CLOCK_T = CLOCK.index("t")
+CLOCK_H = CLOCK.index("h")
+CLOCK_ENERGY_REMOVED = CLOCK.index("energy_removed")
+CLOCK_COLLISION_GAIN = CLOCK.index("collision_gain")
+N_CLOCK = CLOCK.size
+
+# columns of State.energy (J): a ring's energy, its free part (kinetic plus elastic and gas energy
+# above the inflated circle at rest, gravity left out) and its energy budget (the energy at the
+# start plus what actuation and collision impulses gave it since)
+ENERGY = Layout("total", "free", "budget")
+ENERGY_TOTAL = ENERGY.index("total")
+ENERGY_FREE = ENERGY.index("free")
+ENERGY_BUDGET = ENERGY.index("budget")
+
+# Workspace.energy_tally of a trial step: rings whose energy the budget lowered, the energy it
+# removed (J), the net energy the step's collision impulses created (J; 0 if they removed energy)
+TALLY = Layout("projected", "removed", "collision_gain")
+TALLY_PROJECTED = TALLY.index("projected")
+TALLY_REMOVED = TALLY.index("removed")
+TALLY_COLLISION_GAIN = TALLY.index("collision_gain")
+
+# rows of the event buffer: t (s), ring, kind (EVENT_KINDS), centre-of-mass height (m)
+EVENT = Layout("t", "ring", "kind", "height")
+EVENT_KINDS = ("touchdown", "liftoff", "apex")
+EVENT_TOUCHDOWN, EVENT_LIFTOFF, EVENT_APEX = range(len(EVENT_KINDS))

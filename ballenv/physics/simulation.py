@@ -1,0 +1,406 @@
+"""The one driver of a simulation: build a scene once, advance it, actuate it, read it.
+
+:class:`Simulation` owns a scene's compiled arrays (``Model``, ``Solver``, ``State``, workspace,
+clock, counters and the recording) and advances them with :func:`stepper.advance`; between
+advances the gas amount of a ring can be set and impulses applied (:mod:`.actuation`), exactly
+as the env does. :func:`ballenv.physics.simulate` is a Simulation run once to its end; the scenes
+that actuate between bounces drive one directly. :class:`SimulationStats` and :class:`Trajectory`
+are read off it.
+"""
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import ring as ring_geometry
+from .actuation import apply_impulse, set_rest_pressure
+from .assembly import ENERGY_PARTS, ring_energy
+from .collision import find_contacts
+from .effects import EFFECTS
+from .events import EVENT_APEX, event_list
+from .integrator import build_solver
+from .layout import (
+    CLOCK_COLLISION_GAIN,
+    CLOCK_ENERGY_REMOVED,
+    CLOCK_H,
+    CLOCK_T,
+    COUNT_BY_REASON,
+    COUNT_ENERGY_PROJECTED,
+    COUNT_EVENTS,
+    COUNT_IMPULSE_REJECTED,
+    COUNT_NEWTON,
+    COUNT_RECORDS,
+    COUNT_REJECTED,
+    COUNT_REJECTION,
+    COUNT_STEPS,
+    N_CLOCK,
+    N_COUNTERS,
+    REJECTION_REASONS,
+    REJECTIONS,
+    STATUS_BUFFER_FULL,
+    STATUS_DONE,
+    STATUS_IMPULSE_AT_DT_MIN,
+    STATUS_STEP_TOO_SMALL,
+)
+from .model import build_model, build_workspace, empty_recording, empty_state
+from .scene import Scene, check_real
+from .stepper import advance, initial_state_values, record
+
+EVENT_ROWS_PER_RING = 64  # starting room of the event buffer (it grows)
+RECORDS = 1024  # starting room of the recording when every step is recorded (it grows)
+
+
+class SimulationError(RuntimeError):
+    """The simulation cannot continue (e.g. the step size fell below ``Scene.dt_min``).
+
+    ``trajectory`` holds everything accepted up to the failure.
+    """
+
+    def __init__(self, message, trajectory=None):
+        super().__init__(message)
+        self.trajectory = trajectory
+
+
+@dataclass(frozen=True)
+class SimulationStats:
+    """Cost of a run: accepted and rejected steps, Newton iterations (linear solves), wall time (s);
+    ``rejections`` counts the rejected steps by reason ("newton", "energy", "intrusion",
+    "self_intersection", "impulse": the adaptive step's contact impulse above ``impulse_tol``);
+    ``energy_projected``: accepted (step, ring) pairs whose energy rose above the ring's budget (its
+    start energy plus the work of actuation and collisions) by a small step error, removed from the
+    ring's velocities relative to its centre of mass; ``energy_removed`` (J): the sum of those
+    excesses (``energy.within_energy_budget``); ``collision_gain`` (J): the energy ring-ring and
+    self-contact impulses created by pushing out nodes that started a step inside the contact
+    distance, summed over the steps where their net effect was a gain (the one source of energy
+    besides actuation)."""
+
+    steps: int
+    rejected_steps: int
+    newton_iterations: int
+    wall_time: float
+    effects: tuple
+    integrator: str
+    rejections: dict = field(default_factory=dict)  # rejected steps by reason (layout.REJECTIONS)
+    energy_projected: int = 0
+    energy_removed: float = 0.0
+    collision_gain: float = 0.0
+
+
+@dataclass
+class Trajectory:
+    """Recorded states of a simulation (SI units).
+
+    Attributes:
+        t: (T,) time (s).
+        x: (T, n_rings, n_nodes, 2) node positions (m).
+        v: (T, n_rings, n_nodes, 2) node velocities (m/s).
+        pressure: (T, n_rings) gauge pressure (Pa); 0 for rings without gas.
+        contact_force: (T, n_rings, n_nodes, 2) ground reaction (N); zero without grounds.
+        events: list of (t, ring, kind) with kind in {"touchdown", "liftoff", "apex"}.
+        stats: :class:`SimulationStats`.
+        scene: the simulated :class:`Scene`.
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    v: np.ndarray
+    pressure: np.ndarray
+    contact_force: np.ndarray
+    events: list
+    stats: SimulationStats
+    scene: Scene = field(repr=False)
+    event_table: np.ndarray = field(default=None, repr=False)
+
+    def apexes(self, ring=0):
+        """(k, 2) array of (t (s), centre-of-mass height (m)) at the apexes of ``ring``,
+        interpolated inside the step (cubic Hermite), not sampled."""
+        rows = self.event_table
+        if rows is None or len(rows) == 0:
+            return np.zeros((0, 2))
+        sel = (rows[:, 1] == ring) & (rows[:, 2] == EVENT_APEX)
+        return rows[sel][:, [0, 3]]
+
+    def centre_of_mass(self):
+        """(T, n_rings, 2) centre of mass (m); nodes of a ring have equal mass."""
+        return self.x.mean(axis=2)
+
+    def energy(self):
+        """Energy (J) per record and ring: dict of (T, n_rings) arrays.
+
+        Keys: kinetic, stretching, bending, gas (the gas-law potential), gravity, total.
+        """
+        return energy(self.scene, self.x, self.v)
+
+    def save(self, path):
+        """Write this trajectory to ``path`` (a compressed ``.npz``; layout in
+        :mod:`ballenv.physics.trajectory_io`); returns the path written."""
+        from .trajectory_io import save
+
+        return save(self, path)
+
+    @classmethod
+    def load(cls, path):
+        """A trajectory saved by :meth:`save`, exactly as it was (ValueError on a foreign file)."""
+        from .trajectory_io import load
+
+        return load(path)
+
+
+def energy(scene, x, v):
+    """Mechanical plus gas energy (J) of states ``x, v`` (..., n_rings, n_nodes, 2); see Trajectory."""
+    model = build_model(scene)
+    x = np.asarray(x, dtype=float)
+    v = np.asarray(v, dtype=float)
+    lead = x.shape[:-2]
+    xs = np.ascontiguousarray(x.reshape(-1, x.shape[-2], 2))
+    vs = np.ascontiguousarray(v.reshape(-1, x.shape[-2], 2))
+    n_rings = len(scene.rings)
+    table = np.zeros((xs.shape[0], len(ENERGY_PARTS)))
+    for k in range(xs.shape[0]):
+        ring_energy(model, k % n_rings, xs[k], vs[k], table[k])
+    out = {name: table[:, j].reshape(lead) for j, name in enumerate(ENERGY_PARTS)}
+    out["total"] = table.sum(axis=1).reshape(lead)
+    return out
+
+
+def initial_state(scene):
+    """Node positions and velocities (R, N, 2) of the scene's rings at t = 0."""
+    pairs = [ring_geometry.initial_nodes(r) for r in scene.rings]
+    return np.stack([p[0] for p in pairs]), np.stack([p[1] for p in pairs])
+
+
+class Simulation:
+    """A scene's simulation from ``x0, v0`` (default: the rings' circles and rigid motions) at t = 0.
+
+    Args:
+        scene: the :class:`Scene`.
+        x0, v0: optional initial node positions (m) and velocities (m/s), shape (n_rings, n_nodes, 2)
+            (or (n_nodes, 2) for one ring).
+        output_dt: record interval (s); None records every accepted step.
+        expected_end: the time (s) the run is expected to reach, to size the recording (it grows).
+        effects: the force effects summed on each ring: the registry ``ballenv.physics.effects.EFFECTS``
+            by default, or another list of effect modules (e.g. the registry plus a new force).
+
+    ``advance(t)`` steps to time ``t`` (s); ``set_rest_pressure``, ``apply_impulse`` actuate between
+    advances; ``trajectory()`` and ``stats()`` read what was recorded. Raises ValueError on invalid
+    ``x0``/``v0`` (shape, non-finite, below a ground, rings inside each other).
+    """
+
+    def __init__(self, scene, x0=None, v0=None, output_dt=None, expected_end=None, effects=EFFECTS):
+        if not isinstance(scene, Scene):
+            raise ValueError(f"simulate.scene = {scene!r} is invalid: must be a ballenv.physics.Scene")
+        start = time.perf_counter()
+        self.scene = scene
+        self.output_dt = output_dt
+        self.model = build_model(scene, effects)
+        self.solver = build_solver(scene)
+        n_rings, n_nodes = len(scene.rings), scene.rings[0].n_nodes
+        self.ws = build_workspace(n_nodes, n_rings, effects)
+        self.state = empty_state(n_rings, n_nodes)
+        self.trial = empty_state(n_rings, n_nodes)
+        shape = (n_rings, n_nodes, 2)
+        x_init, v_init = initial_state(scene)
+        self.state.x[:] = _check_state("x0", x0, shape) if x0 is not None else x_init
+        self.state.v[:] = _check_state("v0", v0, shape) if v0 is not None else v_init
+        _check_above_grounds(self.model.grounds, self.state.x)
+        if self.model.collide:
+            _check_apart(self.model, self.state.x, self.ws)
+        initial_state_values(self.model, self.solver, self.state, self.ws)
+        self.clock = np.zeros(N_CLOCK)
+        self.clock[CLOCK_H] = self.solver.dt
+        self.counters = np.zeros(N_COUNTERS, dtype=np.int64)
+        capacity = 1 + (int(np.ceil(expected_end / output_dt)) + 1 if output_dt and expected_end else RECORDS)
+        self.rec = empty_recording(capacity, n_rings, n_nodes, EVENT_ROWS_PER_RING * n_rings)
+        record(self.model, 0, 0.0, self.state, self.rec)
+        self.counters[COUNT_RECORDS] = 1
+        self.failure = None
+        self._wall = time.perf_counter() - start  # s: building, then advancing
+
+    @property
+    def t(self):
+        """Simulated time (s)."""
+        return float(self.clock[CLOCK_T])
+
+    def advance(self, t, progress=False):
+        """Step to time ``t`` (s; steps land on it); with ``progress`` a progress bar over simulated
+        time. Returns True, or False when the run cannot go on: ``failure`` then says why (the
+        state is the last accepted one). ValueError for a ``t`` before the simulated time."""
+        t = check_real("Simulation.advance", "t", t, self.t, 1e6, "s (not before the simulated time)")
+        start = time.perf_counter()
+        bar = _progress_bar(t) if progress else None
+        chunk = t / 100.0 if progress else t
+        target = 0.0
+        status = STATUS_DONE
+        while self.clock[CLOCK_T] < t:
+            target = min(t, max(target, self.clock[CLOCK_T]) + chunk)
+            status = self._advance_to(target, t)
+            if bar is not None:
+                bar.update(self.clock[CLOCK_T] - bar.n)
+            if status != STATUS_DONE:
+                self.failure = self._failure_message(status)
+                break
+        if bar is not None:
+            bar.close()
+        self._wall += time.perf_counter() - start
+        return status == STATUS_DONE
+
+    def _advance_to(self, target, t_end):
+        """Compiled steps until ``target`` (s), landing on ``t_end``; grows the recording when full."""
+        while True:
+            status = advance(
+                self.model, self.solver, self.ws, self.state, self.trial, self.clock, self.counters,
+                target, t_end, 0.0 if self.output_dt is None else self.output_dt, self.rec,
+            )  # fmt: skip
+            if status != STATUS_BUFFER_FULL:
+                return status
+            self.rec = _grown(self.rec, self.counters)
+
+    def _failure_message(self, status):
+        scene, t = self.scene, self.t
+        if status == STATUS_IMPULSE_AT_DT_MIN:
+            return (
+                f"the contact impulse per step stayed above Scene.impulse_tol = {scene.impulse_tol:g} N s "
+                f"at the smallest step Scene.dt_min = {scene.dt_min:g} s (t = {t:.6g} s); raise "
+                "impulse_tol or lower dt_min."
+            )
+        assert status == STATUS_STEP_TOO_SMALL, status
+        reason = REJECTION_REASONS.get(int(self.counters[COUNT_REJECTION]), "the step was rejected")
+        return (
+            f"step size fell below Scene.dt_min = {scene.dt_min:g} s at t = {t:.6g} s "
+            f"(tried {self.clock[CLOCK_H] * 2:.3g} s): {reason}. The scene may be too stiff or too "
+            "violent for its settings; lower Scene.dt or raise Scene.newton_max_iter."
+        )
+
+    @property
+    def event_count(self):
+        """Event rows recorded so far."""
+        return int(self.counters[COUNT_EVENTS])
+
+    def event_rows(self, start=0):
+        """Event rows from ``start`` on: (t (s), ring, kind, centre-of-mass height (m))."""
+        return self.rec.events[start : self.event_count].copy()
+
+    def set_rest_pressure(self, ring, pressure):
+        """Set ring ``ring``'s gas to the amount whose gauge pressure at rest is ``pressure`` (Pa)
+        (:func:`actuation.set_rest_pressure`; the ring must hold gas)."""
+        if not self.model.pressurised[ring]:
+            raise ValueError(f"Simulation.set_rest_pressure: ring {ring} holds no gas (Ring.pressure None)")
+        s = self.state
+        set_rest_pressure(
+            self.model, ring, float(pressure), s.x[ring], s.v[ring], s.a[ring], s.active[ring],
+            s.energy[ring], self.ws,
+        )  # fmt: skip
+
+    def apply_impulse(self, ring, nodes, impulse):
+        """Add momentum ``impulse`` (N s, a pair) to ring ``ring``, shared equally by ``nodes``."""
+        nodes = np.asarray(nodes, dtype=np.int64)
+        s = self.state
+        apply_impulse(
+            self.model, ring, s.x[ring], s.v[ring], s.a[ring], s.active[ring], s.energy[ring], self.ws,
+            nodes, len(nodes), float(impulse[0]), float(impulse[1]),
+        )  # fmt: skip
+
+    def stats(self):
+        """:class:`SimulationStats` so far."""
+        c, clock = self.counters, self.clock
+        return SimulationStats(
+            steps=int(c[COUNT_STEPS]),
+            rejected_steps=int(c[COUNT_REJECTED]),
+            newton_iterations=int(c[COUNT_NEWTON]),
+            wall_time=self._wall,
+            effects=self.scene.effects,
+            integrator=self.scene.integrator,
+            rejections={
+                **{name: int(c[COUNT_BY_REASON + k]) for k, name in enumerate(REJECTIONS)},
+                "impulse": int(c[COUNT_IMPULSE_REJECTED]),
+            },
+            energy_projected=int(c[COUNT_ENERGY_PROJECTED]),
+            energy_removed=float(clock[CLOCK_ENERGY_REMOVED]),
+            collision_gain=float(clock[CLOCK_COLLISION_GAIN]),
+        )
+
+    def trajectory(self):
+        """The :class:`Trajectory` recorded so far (copies)."""
+        rec = self.rec
+        n_out = int(self.counters[COUNT_RECORDS])
+        n_ev = int(self.counters[COUNT_EVENTS])
+        return Trajectory(
+            t=rec.t[:n_out].copy(),
+            x=rec.x[:n_out].copy(),
+            v=rec.v[:n_out].copy(),
+            pressure=rec.pressure[:n_out].copy(),
+            contact_force=rec.contact_force[:n_out].copy(),
+            events=event_list(rec.events[:n_ev]),
+            stats=self.stats(),
+            scene=self.scene,
+            event_table=rec.events[:n_ev].copy(),
+        )
+
+
+def _check_state(name, value, shape):
+    try:
+        arr = np.asarray(value)
+    except (TypeError, ValueError):  # ragged nesting
+        arr = np.asarray(None)
+    if arr.dtype.kind not in "iuf":
+        raise ValueError(
+            f"simulate.{name} = {value!r} is invalid: must be an array of real numbers of shape {shape} "
+            "(m or m/s)"
+        )
+    arr = arr.astype(float)
+    if arr.shape == shape[1:] and shape[0] == 1:
+        arr = arr[None]
+    if arr.shape != shape:
+        raise ValueError(f"simulate.{name} has shape {arr.shape}: must be {shape} (m or m/s)")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"simulate.{name} contains NaN or inf: must be finite")
+    return arr.copy()
+
+
+def _grown(rec, counters):
+    """A recording with room for more records and events, holding what ``rec`` has."""
+    n_out = int(counters[COUNT_RECORDS])
+    n_ev = int(counters[COUNT_EVENTS])
+    out_cap = rec.t.shape[0] * (2 if n_out >= rec.t.shape[0] else 1)
+    ev_cap = rec.events.shape[0] * 2
+    grown = empty_recording(out_cap, rec.x.shape[1], rec.x.shape[2], ev_cap)
+    for old, new in zip(rec[:-1], grown[:-1], strict=True):
+        new[:n_out] = old[:n_out]
+    grown.events[:n_ev] = rec.events[:n_ev]
+    return grown
+
+
+def _check_above_grounds(grounds, x):
+    for g, (nx, ny, d, _) in enumerate(grounds):
+        phi = x[..., 0] * nx + x[..., 1] * ny - d
+        if np.any(phi < 0.0):
+            ring, node = np.argwhere(phi < 0.0)[0]
+            raise ValueError(
+                f"simulate: node {node} of ring {ring} starts {-phi[ring, node]:.3g} m below "
+                f"Scene.grounds[{g}]: every node must start on or above every ground"
+            )
+
+
+def _check_apart(model, x, ws):
+    count = find_contacts(x, model.thickness, ws.collision)
+    inside = ws.collision.contacts[:count]
+    inside = inside[inside[:, 5] < 0.0]
+    if len(inside):
+        a, i, b = (int(v) for v in inside[0, :3])
+        raise ValueError(
+            f"simulate: node {i} of ring {a} starts inside ring {b}: rings must start apart "
+            "(Scene.rings positions and radii, or x0)"
+        )
+
+
+def _progress_bar(t_end):
+    from tqdm.auto import tqdm
+
+    return tqdm(
+        total=t_end,
+        unit="s",
+        unit_scale=False,
+        desc="simulate",
+        bar_format="{l_bar}{bar}| {n:.3g}/{total:.3g} s [{elapsed}<{remaining}]",
+    )

@@ -1,0 +1,73 @@
+"""The one driver: Simulation advances in pieces, actuates between them and reports its run."""
+
+import numpy as np
+import pytest
+
+from ballenv.physics import Ground, Ring, Scene, Simulation, simulate
+from ballenv.physics.layout import ENERGY_BUDGET, ENERGY_TOTAL
+
+
+def _scene(**kw):
+    settings = dict(grounds=[Ground(friction=0.5)], adaptive=True, dt=1e-2) | kw
+    return Scene(rings=[Ring(n_nodes=16, pressure=20e3)], **settings)
+
+
+def test_one_advance_is_simulate():
+    scene = _scene()
+    sim = Simulation(scene, expected_end=0.3)
+    assert sim.advance(0.3)
+    traj, ref = sim.trajectory(), simulate(scene, 0.3)
+    np.testing.assert_array_equal(traj.x, ref.x)
+    assert traj.stats.newton_iterations == ref.stats.newton_iterations
+
+
+def test_advance_in_pieces_lands_on_each_time_and_keeps_counting():
+    sim = Simulation(_scene(), output_dt=0.01)
+    assert sim.advance(0.125)
+    assert sim.t == 0.125
+    steps = sim.stats().steps
+    assert sim.advance(0.6)
+    traj = sim.trajectory()
+    assert sim.t == 0.6 and traj.t[-1] == 0.6
+    assert np.all(np.diff(traj.t) > 0) and 0.125 in traj.t
+    assert sim.stats().steps > steps
+    assert [kind for _, _, kind in traj.events][:1] == ["touchdown"]
+
+
+def test_gas_and_impulse_between_advances_credit_the_energy_budget_exactly():
+    sim = Simulation(_scene(gravity=0.0, grounds=()))
+    assert sim.advance(0.01)
+    m = sim.model.node_mass[0]
+    before = sim.state.energy[0].copy()
+    momentum = m * sim.state.v[0].sum(axis=0)
+    sim.apply_impulse(0, [0, 1, 2, 3], (0.02, -0.01))
+    np.testing.assert_allclose(m * sim.state.v[0].sum(axis=0) - momentum, [0.02, -0.01], rtol=1e-12)
+    sim.set_rest_pressure(0, 35e3)
+    after = sim.state.energy[0]
+    gained = after[ENERGY_TOTAL] - before[ENERGY_TOTAL]
+    assert gained != 0.0
+    assert after[ENERGY_BUDGET] - before[ENERGY_BUDGET] == pytest.approx(gained, rel=1e-12)
+    assert sim.advance(0.05)  # and the run goes on within its new budget
+
+
+def test_gas_of_a_ring_without_gas_is_refused():
+    sim = Simulation(Scene(rings=[Ring(n_nodes=8, pressure=None)]))
+    with pytest.raises(ValueError, match="ring 0 holds no gas"):
+        sim.set_rest_pressure(0, 1e4)
+
+
+def test_a_failed_advance_says_why_and_keeps_the_last_accepted_state():
+    scene = Scene(rings=[Ring(n_nodes=16)], grounds=[Ground()], adaptive=True, dt=1e-2, dt_min=1e-3,
+                  impulse_tol=1e-6)  # fmt: skip
+    sim = Simulation(scene)
+    assert not sim.advance(1.0)
+    assert "impulse_tol" in sim.failure
+    assert np.all(np.isfinite(sim.state.x)) and sim.t < 1.0
+
+
+def test_advance_refuses_a_time_in_the_past_or_not_a_number():
+    sim = Simulation(_scene())
+    assert sim.advance(0.01)
+    for bad in (0.005, float("nan"), "1"):
+        with pytest.raises(ValueError, match="Simulation.advance.t"):
+            sim.advance(bad)
