@@ -29,7 +29,10 @@ from ..physics.layout import (
     ENERGY_BUDGET,
     ENERGY_FREE,
     ENERGY_TOTAL,
+    EVENT,
     EVENT_APEX,
+    EVENT_HEIGHT,
+    EVENT_KIND,
     EVENT_LIFTOFF,
     EVENT_TOUCHDOWN,
     N_CLOCK,
@@ -234,13 +237,13 @@ def _actuate(me, se, task, e, action, ws, nodes):
 @njit(cache=True)
 def _tally(task, e, events, n_events):
     for k in range(n_events):
-        kind = int(events[k, 2])
+        kind = int(events[k, EVENT_KIND])
         if kind == EVENT_TOUCHDOWN:
             task.airborne[e] = False
         elif kind == EVENT_LIFTOFF:
             task.airborne[e] = True
         elif kind == EVENT_APEX and task.airborne[e]:
-            h = events[k, 3] - task.ground_height
+            h = events[k, EVENT_HEIGHT] - task.ground_height
             task.apex_count[e] += 1
             task.apex_error[e] += abs(h - task.target[e]) / task.target[e]
             task.apex_height[e] = h
@@ -403,7 +406,7 @@ class BallBatch:
             v=np.zeros(shape),
             pressure=np.zeros((n_envs, 1, 1)),
             contact_force=np.zeros(shape),
-            events=np.zeros((n_envs, EVENT_ROWS, 4)),
+            events=np.zeros((n_envs, EVENT_ROWS, EVENT.size)),
         )
         zeros = np.zeros(n_envs)
         self.task = Task(

@@ -7,10 +7,10 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from ..physics import Ground, Ring, Scene
+from ..physics.layout import STATUS_IMPULSE_AT_DT_MIN, STATUS_STEP_TOO_SMALL
 from ..physics.presets import FIDELITY_PRESETS, with_fidelity
 from ..physics.ring import inflation_ratio_of
 from ..physics.scene import check_choice, check_real
-from ..physics.stepper import STATUS_IMPULSE_AT_DT_MIN, STATUS_STEP_TOO_SMALL
 from . import observation
 from .batch import END_FAILURE, MODE_PADDLE, MODE_PRESSURE
 

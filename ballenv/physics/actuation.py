@@ -72,9 +72,9 @@ def apply_impulse(model, r, x, v, a, active, energy, ws, nodes, count, jx, jy):
 
 @njit(cache=True)
 def restart(model, r, x, v, a, active, energy, ws):
-    """Recompute ring ``r``'s carried energy (3,) and start acceleration ``a = F / m`` (normal part
-    zeroed on ground-constrained nodes, which rest on the surface) after an actuation; the change
-    of energy is added to the ring's energy budget."""
+    """Recompute ring ``r``'s carried energy (columns ``layout.ENERGY``) and start acceleration
+    ``a = F / m`` (normal part zeroed on ground-constrained nodes, which rest on the surface) after
+    an actuation; the change of energy is added to the ring's energy budget."""
     before = energy[ENERGY_TOTAL]
     free_energy(model, r, x, v, ws.energy, energy)
     energy[ENERGY_BUDGET] += energy[ENERGY_TOTAL] - before

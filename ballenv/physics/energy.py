@@ -45,7 +45,7 @@ def energy_grew(total_before, free_before, total_after, free_after):
 @njit(cache=True)
 def _energy_scale(model, r, x, parts):
     """Size (J) of the terms that make up ring ``r``'s energy, for round-off tolerances: the sum of
-    |energy parts| ``parts`` (5,), with gravity's part taken node by node, ``m |g_d x_i,d|`` summed
+    |energy parts| ``parts``, with gravity's part taken node by node, ``m |g_d x_i,d|`` summed
     (the ring's gravity energy can cancel to nearly 0 while its nodes' terms do not)."""
     scale = 0.0
     g = gravity_column(model)

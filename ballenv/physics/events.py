@@ -17,7 +17,16 @@ from numba import njit
 
 from .contact import FREE, deepest_ground
 from .geometry import centre_of_mass
-from .layout import EVENT_APEX, EVENT_KINDS, EVENT_LIFTOFF, EVENT_TOUCHDOWN
+from .layout import (
+    EVENT_APEX,
+    EVENT_HEIGHT,
+    EVENT_KIND,
+    EVENT_KINDS,
+    EVENT_LIFTOFF,
+    EVENT_RING,
+    EVENT_T,
+    EVENT_TOUCHDOWN,
+)
 
 __all__ = ["EVENT_APEX", "EVENT_KINDS", "EVENT_LIFTOFF", "EVENT_TOUCHDOWN", "detect_events", "event_list"]
 
@@ -35,6 +44,16 @@ def _hermite(y0, y1, d0, d1, s):
     s2 = s * s
     s3 = s2 * s
     return (2 * s3 - 3 * s2 + 1) * y0 + (s3 - 2 * s2 + s) * d0 + (-2 * s3 + 3 * s2) * y1 + (s3 - s2) * d1
+
+
+@njit(cache=True)
+def _write(events, n_events, t, ring, kind, height):
+    """Write event row ``n_events`` (columns ``layout.EVENT``); return the new count."""
+    events[n_events, EVENT_T] = t
+    events[n_events, EVENT_RING] = ring
+    events[n_events, EVENT_KIND] = kind
+    events[n_events, EVENT_HEIGHT] = height
+    return n_events + 1
 
 
 @njit(cache=True)
@@ -64,27 +83,25 @@ def detect_events(model, state, trial, t, h, events, n_events):
                     if vn < 0.0:
                         s_first = min(s_first, max(0.0, phi0 / (-vn * h)))
                 s_first = min(s_first, 1.0)
-                events[n_events, 0] = t + s_first * h
-                events[n_events, 1] = r
-                events[n_events, 2] = EVENT_TOUCHDOWN
-                events[n_events, 3] = _hermite(y0, y1, vy0 * h, vy1 * h, s_first)
-                n_events += 1
+                n_events = _write(
+                    events,
+                    n_events,
+                    t + s_first * h,
+                    r,
+                    EVENT_TOUCHDOWN,
+                    _hermite(y0, y1, vy0 * h, vy1 * h, s_first),
+                )
             elif before > 0 and after == 0:
-                events[n_events, 0] = t + h
-                events[n_events, 1] = r
-                events[n_events, 2] = EVENT_LIFTOFF
-                events[n_events, 3] = y1
-                n_events += 1
+                n_events = _write(events, n_events, t + h, r, EVENT_LIFTOFF, y1)
         if vy0 > 0.0 and vy1 <= 0.0:
             s = vy0 / (vy0 - vy1)
-            events[n_events, 0] = t + s * h
-            events[n_events, 1] = r
-            events[n_events, 2] = EVENT_APEX
-            events[n_events, 3] = _hermite(y0, y1, vy0 * h, vy1 * h, s)
-            n_events += 1
+            n_events = _write(
+                events, n_events, t + s * h, r, EVENT_APEX, _hermite(y0, y1, vy0 * h, vy1 * h, s)
+            )
     return n_events
 
 
 def event_list(rows):
     """Event rows -> list of (t, ring, kind) tuples."""
-    return [(float(t), int(r), EVENT_KINDS[int(k)]) for t, r, k, _ in np.asarray(rows)]
+    rows = np.asarray(rows)
+    return [(float(row[EVENT_T]), int(row[EVENT_RING]), EVENT_KINDS[int(row[EVENT_KIND])]) for row in rows]

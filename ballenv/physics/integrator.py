@@ -125,14 +125,16 @@ def kinematics(solver, x0, v0, a0, h, x1, v1, a1, ws):
     cancellation ``x1 - x0``, whose round-off would grow like ``1 / h^2``."""
     n = x1.shape[0]
     dx = ws.dx
+    xe = ws.xe
+    ve = ws.ve
     if solver.method == METHOD_BACKWARD_EULER:
         for i in range(n):
             for d in range(2):
                 x1[i, d] = x0[i, d] + dx[i, d]
                 v1[i, d] = dx[i, d] / h
                 a1[i, d] = (dx[i, d] - h * v0[i, d]) / (h * h)
-                ws.xe[i, d] = x1[i, d]
-                ws.ve[i, d] = v1[i, d]
+                xe[i, d] = x1[i, d]
+                ve[i, d] = v1[i, d]
         return
     beta = solver.beta
     gamma = solver.gamma
@@ -142,5 +144,5 @@ def kinematics(solver, x0, v0, a0, h, x1, v1, a1, ws):
             x1[i, d] = x0[i, d] + dx[i, d]
             a1[i, d] = (dx[i, d] - h * v0[i, d]) / (beta * h * h) - (0.5 - beta) / beta * a0[i, d]
             v1[i, d] = v0[i, d] + h * ((1.0 - gamma) * a0[i, d] + gamma * a1[i, d])
-            ws.xe[i, d] = x0[i, d] + (1.0 - af) * dx[i, d]
-            ws.ve[i, d] = (1.0 - af) * v1[i, d] + af * v0[i, d]
+            xe[i, d] = x0[i, d] + (1.0 - af) * dx[i, d]
+            ve[i, d] = (1.0 - af) * v1[i, d] + af * v0[i, d]

@@ -24,7 +24,7 @@ from .assembly import (
 from .collision import CONTACT_COLUMNS, CONTACTS_PER_NODE
 from .effects import EFFECTS
 from .effects.damping import DAMPING_CENTRE_OF_MASS, DAMPING_NONE, DAMPING_RIGID
-from .layout import ENERGY, TALLY
+from .layout import ENERGY, EVENT, TALLY
 from .linalg import BAND_COLUMNS, MAX_LOW_RANK, zigzag_positions
 
 CONTACT_NONE = 0
@@ -117,7 +117,7 @@ class Recording(NamedTuple):
     v: np.ndarray  # (T, R, N, 2)
     pressure: np.ndarray  # (T, R)
     contact_force: np.ndarray  # (T, R, N, 2)
-    events: np.ndarray  # (E, 4): t, ring, kind, centre-of-mass height
+    events: np.ndarray  # (E, EVENT.size): t, ring, kind, centre-of-mass height (layout.EVENT)
 
 
 def build_model(scene, effects=EFFECTS):
@@ -191,8 +191,8 @@ def effect_parameters(scene, effects=EFFECTS):
     table = parameter_table(effects, len(scene.rings))
     for k, effect in enumerate(effects):
         if effect.PARAMETERS:
-            for r, ring in enumerate(scene.rings):
-                table[field_name(k, effect)][r] = effect.parameters(scene, ring)
+            for r in range(len(scene.rings)):
+                table[field_name(k, effect)][r] = effect.parameters(scene, r)
     return table
 
 
@@ -270,7 +270,7 @@ def empty_recording(capacity, n_rings, n_nodes, event_capacity):
         v=np.empty(shape),
         pressure=np.empty((capacity, n_rings)),
         contact_force=np.empty(shape),
-        events=np.empty((event_capacity, 4)),
+        events=np.empty((event_capacity, EVENT.size)),
     )
 
 

@@ -15,7 +15,7 @@ A correction that does not lower ``|r|^2`` (Armijo, ``|r_new|^2 > (1 - 2e-4 lam)
 gives a non-finite residual is halved, at most five times (backtracking line search). Full Newton
 steps cycle on Coulomb friction: an arriving node's reaction makes ``mu N s(v_t)`` a near step
 function of its slip (``mu v_n / eps`` ~ 150 at 3 m/s), independent of ``h``, so halving the time step
-alone never recovered.
+alone does not recover.
 """
 
 import math

@@ -24,7 +24,7 @@ def simulate(scene, t_end, x0=None, v0=None, output_dt=None, progress=False):
     t_end = check_real("simulate", "t_end", t_end, 0.0, 1e6, "s", low_open=True)
     if output_dt is not None:
         output_dt = check_real("simulate", "output_dt", output_dt, 0.0, t_end, "s", low_open=True)
-    sim = Simulation(scene, x0, v0, output_dt, expected_end=t_end)
+    sim = Simulation(scene, x0, v0, output_dt, expected_end=t_end, caller="simulate")
     if not sim.advance(t_end, progress):
         raise SimulationError(sim.failure, sim.trajectory())
     return sim.trajectory()

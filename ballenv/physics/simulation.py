@@ -8,8 +8,10 @@ that actuate between bounces drive one directly. :class:`SimulationStats` and :c
 are read off it.
 """
 
+import math
 import time
 from dataclasses import dataclass, field
+from numbers import Integral
 
 import numpy as np
 
@@ -17,8 +19,8 @@ from . import ring as ring_geometry
 from .actuation import apply_impulse, set_rest_pressure
 from .assembly import ENERGY_PARTS, ring_energy
 from .collision import find_contacts
-from .effects import EFFECTS
-from .events import EVENT_APEX, event_list
+from .effects import EFFECTS, scene_effects
+from .events import event_list
 from .integrator import build_solver
 from .layout import (
     CLOCK_COLLISION_GAIN,
@@ -34,6 +36,11 @@ from .layout import (
     COUNT_REJECTED,
     COUNT_REJECTION,
     COUNT_STEPS,
+    EVENT_APEX,
+    EVENT_HEIGHT,
+    EVENT_KIND,
+    EVENT_RING,
+    EVENT_T,
     N_CLOCK,
     N_COUNTERS,
     REJECTION_REASONS,
@@ -44,7 +51,7 @@ from .layout import (
     STATUS_STEP_TOO_SMALL,
 )
 from .model import build_model, build_workspace, empty_recording, empty_state
-from .scene import Scene, check_real
+from .scene import Scene, check_real, check_vector
 from .stepper import advance, initial_state_values, record
 
 EVENT_ROWS_PER_RING = 64  # starting room of the event buffer (it grows)
@@ -118,8 +125,8 @@ class Trajectory:
         rows = self.event_table
         if rows is None or len(rows) == 0:
             return np.zeros((0, 2))
-        sel = (rows[:, 1] == ring) & (rows[:, 2] == EVENT_APEX)
-        return rows[sel][:, [0, 3]]
+        sel = (rows[:, EVENT_RING] == ring) & (rows[:, EVENT_KIND] == EVENT_APEX)
+        return rows[sel][:, [EVENT_T, EVENT_HEIGHT]]
 
     def centre_of_mass(self):
         """(T, n_rings, 2) centre of mass (m); nodes of a ring have equal mass."""
@@ -128,7 +135,9 @@ class Trajectory:
     def energy(self):
         """Energy (J) per record and ring: dict of (T, n_rings) arrays.
 
-        Keys: kinetic, stretching, bending, gas (the gas-law potential), gravity, total.
+        Keys: kinetic, stretching, bending, gas (the gas-law potential), gravity, total. Computed with
+        the scene's gas amounts and the registry's effects: records after a
+        :meth:`Simulation.set_rest_pressure` hold another amount of gas than this counts.
         """
         return energy(self.scene, self.x, self.v)
 
@@ -181,17 +190,25 @@ class Simulation:
         expected_end: the time (s) the run is expected to reach, to size the recording (it grows).
         effects: the force effects summed on each ring: the registry ``ballenv.physics.effects.EFFECTS``
             by default, or another list of effect modules (e.g. the registry plus a new force).
+        caller: the name error messages give (``simulate`` passes its own).
 
     ``advance(t)`` steps to time ``t`` (s); ``set_rest_pressure``, ``apply_impulse`` actuate between
     advances; ``trajectory()`` and ``stats()`` read what was recorded. Raises ValueError on invalid
     ``x0``/``v0`` (shape, non-finite, below a ground, rings inside each other).
     """
 
-    def __init__(self, scene, x0=None, v0=None, output_dt=None, expected_end=None, effects=EFFECTS):
+    def __init__(
+        self, scene, x0=None, v0=None, output_dt=None, expected_end=None, effects=EFFECTS, caller="Simulation"
+    ):
         if not isinstance(scene, Scene):
-            raise ValueError(f"simulate.scene = {scene!r} is invalid: must be a ballenv.physics.Scene")
+            raise ValueError(f"{caller}.scene = {scene!r} is invalid: must be a ballenv.physics.Scene")
+        if output_dt is not None:
+            output_dt = check_real(caller, "output_dt", output_dt, 0.0, 1e6, "s", low_open=True)
+        if expected_end is not None:
+            expected_end = check_real(caller, "expected_end", expected_end, 0.0, 1e6, "s")
         start = time.perf_counter()
         self.scene = scene
+        self.effects = tuple(effects)
         self.output_dt = output_dt
         self.model = build_model(scene, effects)
         self.solver = build_solver(scene)
@@ -201,11 +218,11 @@ class Simulation:
         self.trial = empty_state(n_rings, n_nodes)
         shape = (n_rings, n_nodes, 2)
         x_init, v_init = initial_state(scene)
-        self.state.x[:] = _check_state("x0", x0, shape) if x0 is not None else x_init
-        self.state.v[:] = _check_state("v0", v0, shape) if v0 is not None else v_init
-        _check_above_grounds(self.model.grounds, self.state.x)
+        self.state.x[:] = _check_state(caller, "x0", x0, shape) if x0 is not None else x_init
+        self.state.v[:] = _check_state(caller, "v0", v0, shape) if v0 is not None else v_init
+        _check_above_grounds(caller, self.model.grounds, self.state.x)
         if self.model.collide:
-            _check_apart(self.model, self.state.x, self.ws)
+            _check_apart(caller, self.model, self.state.x, self.ws)
         initial_state_values(self.model, self.solver, self.state, self.ws)
         self.clock = np.zeros(N_CLOCK)
         self.clock[CLOCK_H] = self.solver.dt
@@ -281,24 +298,54 @@ class Simulation:
         """Event rows from ``start`` on: (t (s), ring, kind, centre-of-mass height (m))."""
         return self.rec.events[start : self.event_count].copy()
 
+    def _ring_index(self, owner, ring):
+        n_rings = len(self.scene.rings)
+        if isinstance(ring, bool) or not isinstance(ring, Integral) or not 0 <= ring < n_rings:
+            raise ValueError(
+                f"{owner}.ring = {ring!r} is out of range: must be an integer in [0, {n_rings - 1}]"
+            )
+        return int(ring)
+
     def set_rest_pressure(self, ring, pressure):
         """Set ring ``ring``'s gas to the amount whose gauge pressure at rest is ``pressure`` (Pa)
-        (:func:`actuation.set_rest_pressure`; the ring must hold gas)."""
-        if not self.model.pressurised[ring]:
-            raise ValueError(f"Simulation.set_rest_pressure: ring {ring} holds no gas (Ring.pressure None)")
+        (:func:`actuation.set_rest_pressure`), in the range ``Ring.pressure`` allows; the ring must
+        hold gas."""
+        owner = "Simulation.set_rest_pressure"
+        ring = self._ring_index(owner, ring)
+        spec = self.scene.rings[ring]
+        if spec.pressure is None:
+            raise ValueError(f"{owner}: ring {ring} holds no gas (Ring.pressure None)")
+        burst = 0.5 * spec.youngs_modulus * spec.thickness / (spec.radius * math.cos(math.pi / spec.n_nodes))
+        unit = "Pa; the upper bound inflates the wall by 100 %"
+        pressure = check_real(owner, "pressure", pressure, 0.0, min(1e8, burst), unit)
         s = self.state
         set_rest_pressure(
-            self.model, ring, float(pressure), s.x[ring], s.v[ring], s.a[ring], s.active[ring],
+            self.model, ring, pressure, s.x[ring], s.v[ring], s.a[ring], s.active[ring],
             s.energy[ring], self.ws,
         )  # fmt: skip
 
     def apply_impulse(self, ring, nodes, impulse):
-        """Add momentum ``impulse`` (N s, a pair) to ring ``ring``, shared equally by ``nodes``."""
-        nodes = np.asarray(nodes, dtype=np.int64)
+        """Add momentum ``impulse`` (N s, a pair, each at most 1e3 N s) to ring ``ring``, shared
+        equally by ``nodes`` (distinct node indices of the ring)."""
+        owner = "Simulation.apply_impulse"
+        ring = self._ring_index(owner, ring)
+        n_nodes = self.scene.rings[0].n_nodes
+        chosen = np.asarray(nodes)
+        if (
+            chosen.ndim != 1
+            or chosen.dtype.kind not in "iu"
+            or len(set(chosen.tolist())) != len(chosen)
+            or not np.all((chosen >= 0) & (chosen < n_nodes))
+        ):
+            raise ValueError(
+                f"{owner}.nodes = {nodes!r} is invalid: must be distinct integers in [0, {n_nodes - 1}]"
+            )
+        jx, jy = check_vector(owner, "impulse", impulse, 1e3, "N s")
+        nodes = chosen.astype(np.int64)
         s = self.state
         apply_impulse(
             self.model, ring, s.x[ring], s.v[ring], s.a[ring], s.active[ring], s.energy[ring], self.ws,
-            nodes, len(nodes), float(impulse[0]), float(impulse[1]),
+            nodes, len(nodes), jx, jy,
         )  # fmt: skip
 
     def stats(self):
@@ -309,7 +356,7 @@ class Simulation:
             rejected_steps=int(c[COUNT_REJECTED]),
             newton_iterations=int(c[COUNT_NEWTON]),
             wall_time=self._wall,
-            effects=self.scene.effects,
+            effects=scene_effects(self.scene, self.effects),
             integrator=self.scene.integrator,
             rejections={
                 **{name: int(c[COUNT_BY_REASON + k]) for k, name in enumerate(REJECTIONS)},
@@ -338,23 +385,23 @@ class Simulation:
         )
 
 
-def _check_state(name, value, shape):
+def _check_state(caller, name, value, shape):
     try:
         arr = np.asarray(value)
     except (TypeError, ValueError):  # ragged nesting
         arr = np.asarray(None)
     if arr.dtype.kind not in "iuf":
         raise ValueError(
-            f"simulate.{name} = {value!r} is invalid: must be an array of real numbers of shape {shape} "
+            f"{caller}.{name} = {value!r} is invalid: must be an array of real numbers of shape {shape} "
             "(m or m/s)"
         )
     arr = arr.astype(float)
     if arr.shape == shape[1:] and shape[0] == 1:
         arr = arr[None]
     if arr.shape != shape:
-        raise ValueError(f"simulate.{name} has shape {arr.shape}: must be {shape} (m or m/s)")
+        raise ValueError(f"{caller}.{name} has shape {arr.shape}: must be {shape} (m or m/s)")
     if not np.all(np.isfinite(arr)):
-        raise ValueError(f"simulate.{name} contains NaN or inf: must be finite")
+        raise ValueError(f"{caller}.{name} contains NaN or inf: must be finite")
     return arr.copy()
 
 
@@ -371,25 +418,25 @@ def _grown(rec, counters):
     return grown
 
 
-def _check_above_grounds(grounds, x):
+def _check_above_grounds(caller, grounds, x):
     for g, (nx, ny, d, _) in enumerate(grounds):
         phi = x[..., 0] * nx + x[..., 1] * ny - d
         if np.any(phi < 0.0):
             ring, node = np.argwhere(phi < 0.0)[0]
             raise ValueError(
-                f"simulate: node {node} of ring {ring} starts {-phi[ring, node]:.3g} m below "
+                f"{caller}: node {node} of ring {ring} starts {-phi[ring, node]:.3g} m below "
                 f"Scene.grounds[{g}]: every node must start on or above every ground"
             )
 
 
-def _check_apart(model, x, ws):
+def _check_apart(caller, model, x, ws):
     count = find_contacts(x, model.thickness, ws.collision)
     inside = ws.collision.contacts[:count]
     inside = inside[inside[:, 5] < 0.0]
     if len(inside):
         a, i, b = (int(v) for v in inside[0, :3])
         raise ValueError(
-            f"simulate: node {i} of ring {a} starts inside ring {b}: rings must start apart "
+            f"{caller}: node {i} of ring {a} starts inside ring {b}: rings must start apart "
             "(Scene.rings positions and radii, or x0)"
         )
 

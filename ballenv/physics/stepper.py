@@ -4,7 +4,7 @@
 the step size, output times and the fixed grid), the trial step of every ring (collision impulses,
 Newton's iteration with the contact set, :mod:`.newton`), the acceptance tests (Newton failure,
 self-intersection, energy budget, ring intrusion, contact impulse), then the bookkeeping of a
-rejected (:func:`reject`) or an accepted step (:func:`accept`, events, records) and the next step
+rejected (:func:`step_outcome`) or an accepted step (:func:`accept`, events, records) and the next step
 size. Counters, clock and energy columns are the named layouts of :mod:`.layout`.
 """
 
@@ -51,7 +51,7 @@ from .layout import (
 from .model import CONTACT_NONE
 from .newton import newton_ring
 
-CONTINUE = -1  # reject(): retry the step
+CONTINUE = -1  # step_outcome(): retry the step
 
 
 @njit(cache=True)
@@ -249,7 +249,7 @@ def step_end(solver, clock, counters, t_end, output_dt):
 
 
 @njit(cache=True)
-def reject(model, solver, clock, counters, h, its, impulse):
+def step_outcome(model, solver, clock, counters, h, its, impulse):
     """Bookkeeping of a trial step of size ``h`` (s) that returned ``its`` and ``impulse``:
     ``CONTINUE`` (retry with the new ``clock[CLOCK_H]``), ``STATUS_DONE`` (accept it) or a failure
     status. A rejected step (``its`` < 0) is retried with half the step; an adaptive step whose
@@ -327,7 +327,7 @@ def advance(model, solver, ws, state, trial, clock, counters, t_pause, t_end, ou
         stop, at_end, at_out, at_grid = step_end(solver, clock, counters, t_end, output_dt)
         h = stop - clock[CLOCK_T]
         its, impulse = try_step(model, solver, state, trial, h, ws)
-        status = reject(model, solver, clock, counters, h, its, impulse)
+        status = step_outcome(model, solver, clock, counters, h, its, impulse)
         if status == CONTINUE:
             continue
         if status != STATUS_DONE:

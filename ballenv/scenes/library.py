@@ -292,20 +292,32 @@ def rolling(fidelity="balanced", reduced=False, progress=False):
 # ---------------------------------------------------------------- variable inflation
 
 
-def _advance_to_flight_apex(sim, t_end, interval):
+def _advance_to_flight_apex(sim, t_end, interval, progress):
     """Advance ``sim`` in steps of ``interval`` (s) until the first apex after a lift-off (True) or
-    ``t_end`` (s) (False); raises SimulationError if the run fails."""
+    ``t_end`` (s) (False), with a progress bar if ``progress``; raises SimulationError if the run
+    fails."""
+    bar = _stage_bar(sim.t, t_end) if progress else None
     seen = sim.event_count
     lifted = False
     while sim.t < t_end - 1e-12:
         if not sim.advance(min(t_end, (round(sim.t / interval) + 1) * interval)):
             raise SimulationError(sim.failure, sim.trajectory())
+        if bar is not None:
+            bar.update(sim.t - bar.n)
         for _, _, kind in event_list(sim.event_rows(seen)):
             lifted = lifted or kind == "liftoff"
             if kind == "apex" and lifted:
                 return True
         seen = sim.event_count
     return False
+
+
+def _stage_bar(start, end):
+    from tqdm.auto import tqdm
+
+    return tqdm(
+        total=end, initial=start, unit="s", desc="simulate", bar_format="{l_bar}{bar}| {n:.3g}/{total:.3g} s"
+    )
 
 
 def pumped_bounces(schedule, fidelity, progress, ring_kw, damping, output_dt=1e-3):
@@ -330,7 +342,7 @@ def pumped_bounces(schedule, fidelity, progress, ring_kw, damping, output_dt=1e-
         if k == len(schedule) - 1:
             if not sim.advance(t_stage, progress):
                 raise SimulationError(sim.failure, sim.trajectory())
-        elif not _advance_to_flight_apex(sim, t_stage, output_dt):
+        elif not _advance_to_flight_apex(sim, t_stage, output_dt, progress):
             break
     return sim.trajectory(), switches
 

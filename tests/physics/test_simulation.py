@@ -71,3 +71,29 @@ def test_advance_refuses_a_time_in_the_past_or_not_a_number():
     for bad in (0.005, float("nan"), "1"):
         with pytest.raises(ValueError, match="Simulation.advance.t"):
             sim.advance(bad)
+
+
+@pytest.mark.parametrize(
+    ("call", "field"),
+    [
+        (lambda sim: sim.apply_impulse(0, [0, 99], (0.0, 1.0)), "nodes"),
+        (lambda sim: sim.apply_impulse(0, [1, 1], (0.0, 1.0)), "nodes"),
+        (lambda sim: sim.apply_impulse(0, [0.5], (0.0, 1.0)), "nodes"),
+        (lambda sim: sim.apply_impulse(0, [0], (0.0, float("nan"))), "impulse"),
+        (lambda sim: sim.apply_impulse(1, [0], (0.0, 1.0)), "ring"),
+        (lambda sim: sim.set_rest_pressure(-1, 1e4), "ring"),
+        (lambda sim: sim.set_rest_pressure(0, float("nan")), "pressure"),
+        (lambda sim: sim.set_rest_pressure(0, 1e9), "pressure"),
+    ],
+)
+def test_actuation_refuses_values_out_of_range_naming_them(call, field):
+    sim = Simulation(_scene())
+    with pytest.raises(ValueError, match=rf"Simulation\.(apply_impulse|set_rest_pressure)\.{field}"):
+        call(sim)
+
+
+def test_invalid_settings_name_the_driver():
+    with pytest.raises(ValueError, match=r"Simulation\.output_dt"):
+        Simulation(_scene(), output_dt=-1.0)
+    with pytest.raises(ValueError, match=r"Simulation\.x0"):
+        Simulation(_scene(), x0=np.zeros((3, 2)))

@@ -4,13 +4,13 @@
 attributes:
 
 * ``NAME``: its name in ``Scene.effects``; ``enabled(scene) -> bool`` (Python): does the scene ask
-  for it. What a scene does not name costs nothing.
+  for it. What a scene does not name costs one branch per force evaluation.
 * ``ENERGY_PART``: its column of the energy table (``"gravity"``), or None for a force without a
   potential (damping); ``LOW_RANK``: how many low-rank Jacobian columns it may append (at most).
-* ``PARAMETERS``: names of its own per-ring parameters (SI units), and ``parameters(scene, ring) ->
-  tuple of floats`` (Python) if there are any. They land in its field of the per-ring record
-  ``Model.effect_parameters[r]``; the effect sees them as ``p``. The built-in effects read named
-  ``Model`` fields and declare none.
+* ``PARAMETERS``: names of its own per-ring parameters (SI units), and ``parameters(scene, r) ->
+  tuple of floats`` for ring index ``r`` (Python) if there are any. They land in its field of the
+  per-ring record ``Model.effect_parameters[r]``; the effect sees them as ``p``. The built-in
+  effects read named ``Model`` fields and declare none.
 
 and four numba kernels (``@njit(cache=True)``), for ring ``r`` with nodes ``x`` (N, 2) m and
 velocities ``v`` (N, 2) m/s:

@@ -19,8 +19,8 @@ def enabled(scene):
     return any(LOAD.get(r, (0.0, 0.0)) != (0.0, 0.0) for r in range(len(scene.rings)))
 
 
-def parameters(scene, ring):
-    return LOAD.get(scene.rings.index(ring), (0.0, 0.0))
+def parameters(scene, r):
+    return LOAD.get(r, (0.0, 0.0))
 
 
 @njit(cache=True)
