@@ -39,6 +39,7 @@ from ..physics.layout import (
     N_COUNTERS,
     STATUS_BUFFER_FULL,
     STATUS_DONE,
+    Layout,
 )
 from ..physics.model import (
     PER_RING_FIELDS,
@@ -72,7 +73,13 @@ END_REST = 1
 END_ARENA = 2
 END_FAILURE = 3
 END_REASONS = ("", "rest", "arena", "sim_failure")
-REWARD_TERMS = ("reward_apex", "reward_shaping", "reward_termination")
+REWARD_TERMS = ("reward_apex", "reward_shaping", "reward_termination")  # the terms' info keys
+# columns of Task.reward: the reward, then its terms in the order of REWARD_TERMS
+REWARD = Layout("total", *REWARD_TERMS)
+REWARD_TOTAL = REWARD.index("total")
+REWARD_APEX = REWARD.index("reward_apex")
+REWARD_SHAPING = REWARD.index("reward_shaping")
+REWARD_TERMINATION = REWARD.index("reward_termination")
 NO_OUTPUT = 1e300  # output interval of advance(): record only at the end of the control step
 EVENT_ROWS = 32
 
@@ -110,7 +117,7 @@ class Task(NamedTuple):
     in_reach: np.ndarray  # (E,) bool: the paddle could strike at the start of the last step
     status: np.ndarray  # (E,) int64 stepper status of the last control step
     rise: np.ndarray  # (E,) m: height the ball could still rise (free energy over m g)
-    reward: np.ndarray  # (E, 4): reward and its terms apex, shaping, termination
+    reward: np.ndarray  # (E, REWARD.size): the reward and its terms (columns REWARD)
     end: np.ndarray  # (E,) int64: END_NONE, END_REST, END_ARENA or END_FAILURE
 
 
@@ -334,10 +341,10 @@ def _outcome(task, e, row, n):
         left = max(task.termination_horizon - task.steps[e] * task.control_dt, 0.0) / flight
         termination = -task.termination_weight * left
     task.end[e] = end
-    task.reward[e, 0] = apex + shaping + termination
-    task.reward[e, 1] = apex
-    task.reward[e, 2] = shaping
-    task.reward[e, 3] = termination
+    task.reward[e, REWARD_TOTAL] = apex + shaping + termination
+    task.reward[e, REWARD_APEX] = apex
+    task.reward[e, REWARD_SHAPING] = shaping
+    task.reward[e, REWARD_TERMINATION] = termination
 
 
 @njit(cache=True)
@@ -424,7 +431,7 @@ class BallBatch:
             in_reach=np.zeros(n_envs, dtype=np.bool_),
             status=np.zeros(n_envs, dtype=np.int64),
             rise=zeros.copy(),
-            reward=np.zeros((n_envs, 4)),
+            reward=np.zeros((n_envs, REWARD.size)),
             end=np.zeros(n_envs, dtype=np.int64),
         )
         self.nodes = np.zeros(self.n_nodes, dtype=np.int64)

@@ -4,7 +4,7 @@ import numpy as np
 from gymnasium import Env, spaces
 from gymnasium.utils import EzPickle
 
-from .batch import END_REASONS, REWARD_TERMS, BallBatch, observation_structure
+from .batch import END_REASONS, REWARD, REWARD_TERMS, REWARD_TOTAL, BallBatch, observation_structure
 from .config import BallEnvConfig, draw_reset, failure_message, parse_actions
 
 
@@ -163,11 +163,11 @@ class InflatedBallEnv(Env, EzPickle):
         end = int(task.end[0])
         if self.render_mode == "human":
             self.render()
-        return batch.obs[0].copy(), float(task.reward[0, 0]), end != 0, False, self._step_info()
+        return batch.obs[0].copy(), float(task.reward[0, REWARD_TOTAL]), end != 0, False, self._step_info()
 
     def _step_info(self):
         task = self._batch.task
-        info = {name: float(task.reward[0, k + 1]) for k, name in enumerate(REWARD_TERMS)}
+        info = {name: float(task.reward[0, REWARD.index(name)]) for name in REWARD_TERMS}
         reason = END_REASONS[int(task.end[0])]
         info.update(
             time=float(task.steps[0] * self.config.control_dt),

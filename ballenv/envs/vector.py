@@ -13,7 +13,15 @@ from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from .batch import END_FAILURE, END_REASONS, REWARD_TERMS, BallBatch, observation_structure
+from .batch import (
+    END_FAILURE,
+    END_REASONS,
+    REWARD,
+    REWARD_TERMS,
+    REWARD_TOTAL,
+    BallBatch,
+    observation_structure,
+)
 from .config import BallEnvConfig, draw_reset, failure_message, parse_actions
 from .inflated_ball import InflatedBallEnv
 
@@ -106,13 +114,13 @@ class InflatedBallVectorEnv(VectorEnv):
         stepped = ~resetting
         terminated = (task.end != 0) & stepped
         truncated = (task.steps >= self.max_episode_steps) & stepped
-        reward = np.where(stepped, task.reward[:, 0], 0.0)
+        reward = np.where(stepped, task.reward[:, REWARD_TOTAL], 0.0)
         self._autoreset = terminated | truncated
         return batch.obs.copy(), reward, terminated, truncated, self._step_info(stepped)
 
     def _step_info(self, stepped):
         task = self._batch.task
-        info = {name: np.where(stepped, task.reward[:, k + 1], 0.0) for k, name in enumerate(REWARD_TERMS)}
+        info = {name: np.where(stepped, task.reward[:, REWARD.index(name)], 0.0) for name in REWARD_TERMS}
         reasons = np.where(stepped, np.array(END_REASONS, dtype=object)[task.end], "")
         failures = np.full(self.num_envs, "", dtype=object)
         for i in np.flatnonzero(stepped & (task.end == END_FAILURE)):
