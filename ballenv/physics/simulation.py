@@ -245,7 +245,7 @@ class Simulation:
         state is the last accepted one). ValueError for a ``t`` before the simulated time."""
         t = check_real("Simulation.advance", "t", t, self.t, 1e6, "s (not before the simulated time)")
         start = time.perf_counter()
-        bar = _progress_bar(t) if progress else None
+        bar = progress_bar(t, self.t) if progress else None
         chunk = t / 100.0 if progress else t
         target = 0.0
         status = STATUS_DONE
@@ -441,11 +441,14 @@ def _check_apart(caller, model, x, ws):
         )
 
 
-def _progress_bar(t_end):
+def progress_bar(t_end, start=0.0):
+    """A tqdm bar over simulated time (s) from ``start`` to ``t_end``; ``update`` it by the time
+    advanced and ``close`` it."""
     from tqdm.auto import tqdm
 
     return tqdm(
         total=t_end,
+        initial=start,
         unit="s",
         unit_scale=False,
         desc="simulate",

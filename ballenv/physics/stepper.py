@@ -249,8 +249,9 @@ def step_end(solver, clock, counters, t_end, output_dt):
 
 
 @njit(cache=True)
-def step_outcome(model, solver, clock, counters, h, its, impulse):
-    """Bookkeeping of a trial step of size ``h`` (s) that returned ``its`` and ``impulse``:
+def step_outcome(solver, clock, counters, h, its, ratio):
+    """Bookkeeping of a trial step of size ``h`` (s) that returned ``its`` Newton corrections and
+    ``ratio`` = impulse_tol over its contact impulse:
     ``CONTINUE`` (retry with the new ``clock[CLOCK_H]``), ``STATUS_DONE`` (accept it) or a failure
     status. A rejected step (``its`` < 0) is retried with half the step; an adaptive step whose
     contact impulse exceeds ``impulse_tol`` with ``h * max(0.2, 0.9 tol / (f h))``."""
@@ -261,7 +262,6 @@ def step_outcome(model, solver, clock, counters, h, its, impulse):
         clock[CLOCK_H] = 0.5 * h
         return STATUS_STEP_TOO_SMALL if clock[CLOCK_H] < solver.dt_min else CONTINUE
     counters[COUNT_NEWTON] += its
-    ratio = math.inf if impulse == 0.0 else model.impulse_tol / impulse
     if solver.adaptive and ratio < 1.0:
         if h <= 1.001 * solver.dt_min:  # (h = stop - t carries round-off)
             return STATUS_IMPULSE_AT_DT_MIN
@@ -327,12 +327,12 @@ def advance(model, solver, ws, state, trial, clock, counters, t_pause, t_end, ou
         stop, at_end, at_out, at_grid = step_end(solver, clock, counters, t_end, output_dt)
         h = stop - clock[CLOCK_T]
         its, impulse = try_step(model, solver, state, trial, h, ws)
-        status = step_outcome(model, solver, clock, counters, h, its, impulse)
+        ratio = math.inf if impulse == 0.0 else model.impulse_tol / impulse
+        status = step_outcome(solver, clock, counters, h, its, ratio)
         if status == CONTINUE:
             continue
         if status != STATUS_DONE:
             return status
-        ratio = math.inf if impulse == 0.0 else model.impulse_tol / impulse
         accept(model, solver, ws, state, trial, clock, counters, h, stop, at_grid, ratio, rec)
         if output_dt == 0.0 or at_out or at_end:
             record(model, counters[COUNT_RECORDS], stop, state, rec)

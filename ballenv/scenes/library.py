@@ -16,6 +16,7 @@ from ..physics import Ground, Ring, Scene, Simulation, SimulationError, simulate
 from ..physics.events import event_list
 from ..physics.presets import with_fidelity
 from ..physics.ring import bending_stiffness, inflated_radius, total_mass
+from ..physics.simulation import progress_bar
 
 G = 9.81  # m/s^2
 
@@ -296,7 +297,15 @@ def _advance_to_flight_apex(sim, t_end, interval, progress):
     """Advance ``sim`` in steps of ``interval`` (s) until the first apex after a lift-off (True) or
     ``t_end`` (s) (False), with a progress bar if ``progress``; raises SimulationError if the run
     fails."""
-    bar = _stage_bar(sim.t, t_end) if progress else None
+    bar = progress_bar(t_end, sim.t) if progress else None
+    try:
+        return _steps_to_flight_apex(sim, t_end, interval, bar)
+    finally:
+        if bar is not None:
+            bar.close()
+
+
+def _steps_to_flight_apex(sim, t_end, interval, bar):
     seen = sim.event_count
     lifted = False
     while sim.t < t_end - 1e-12:
@@ -310,14 +319,6 @@ def _advance_to_flight_apex(sim, t_end, interval, progress):
                 return True
         seen = sim.event_count
     return False
-
-
-def _stage_bar(start, end):
-    from tqdm.auto import tqdm
-
-    return tqdm(
-        total=end, initial=start, unit="s", desc="simulate", bar_format="{l_bar}{bar}| {n:.3g}/{total:.3g} s"
-    )
 
 
 def pumped_bounces(schedule, fidelity, progress, ring_kw, damping, output_dt=1e-3):
