@@ -1,4 +1,4 @@
-"""Train a Stable-Baselines3 agent on InflatedBall-v0, then score it next to the baselines.
+"""Train a Stable-Baselines3 agent on InflatedBall-v1, then score it next to the baselines.
 
     python train.py --algo ppo --action-mode pressure            # the README's main command
     python train.py --algo sac --action-mode paddle --total-timesteps 50000 --seed 3
@@ -28,7 +28,7 @@ from dataclasses import asdict
 import numpy as np
 import yaml
 
-ENV_ID = "ballenv:InflatedBall-v0"
+ENV_ID = "ballenv:InflatedBall-v1"
 HYPERPARAMS = pathlib.Path(__file__).parent / "agents" / "hyperparams"
 RUN_KEYS = ("n_timesteps", "n_envs", "policy", "normalize", "env_kwargs")
 
@@ -61,9 +61,9 @@ def parse_args(argv=None):
 
 
 def load_hyperparams(algo, mode):
-    """The YAML entry of ``algo`` for InflatedBall-v0 and ``mode`` (a dict)."""
+    """The YAML entry of ``algo`` for InflatedBall-v1 and ``mode`` (a dict)."""
     table = yaml.safe_load((HYPERPARAMS / f"{algo}.yml").read_text())
-    return dict(table["InflatedBall-v0"][mode])
+    return dict(table["InflatedBall-v1"][mode])
 
 
 def run_folder(log_dir, algo, mode, seed):
@@ -81,7 +81,7 @@ def make_envs(env_kwargs, n_envs, seed, normalize, gamma, monitor_dir=None, trai
     from stable_baselines3.common.env_util import make_vec_env
     from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecNormalize
 
-    gym.make(ENV_ID, **env_kwargs).close()  # compile (or load) numba's cache before any worker starts
+    compile_once(gym, env_kwargs)
     envs = make_vec_env(
         ENV_ID, n_envs=n_envs, seed=seed, env_kwargs=env_kwargs,
         vec_env_cls=SubprocVecEnv if subproc and n_envs > 1 else DummyVecEnv,
@@ -90,6 +90,16 @@ def make_envs(env_kwargs, n_envs, seed, normalize, gamma, monitor_dir=None, trai
     if normalize:
         envs = VecNormalize(envs, norm_obs=True, norm_reward=training, gamma=gamma, training=training)
     return envs
+
+
+def compile_once(gym, env_kwargs):
+    """Reset and step one env here, before any worker process starts: numba compiles the simulator
+    once (or loads it from its cache) and the workers load it from the cache instead of each
+    compiling it."""
+    env = gym.make(ENV_ID, **env_kwargs)
+    env.reset(seed=0)
+    env.step(env.action_space.sample())
+    env.close()
 
 
 def callbacks(run, eval_env, args, n_envs, total):

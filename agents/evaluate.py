@@ -1,4 +1,4 @@
-"""Score a policy on InflatedBall-v0 over held-out episodes.
+"""Score a policy on InflatedBall-v1 over held-out episodes.
 
     python -m agents.evaluate heuristic --action-mode pressure --episodes 20
     python -m agents.evaluate random --action-mode paddle
@@ -28,7 +28,7 @@ import numpy as np
 
 from .baselines import make_policy
 
-ENV_ID = "ballenv:InflatedBall-v0"
+ENV_ID = "ballenv:InflatedBall-v1"
 SUCCESS_TOLERANCE = 0.05  # relative apex error counted as a success
 DEFAULT_SEED = 10_000
 

@@ -53,7 +53,7 @@ class BallRenderer:
         if self.mode == "human" and self.window is None:
             pg.display.init()
             self.window = pg.display.set_mode((SIZE, SIZE))
-            pg.display.set_caption("InflatedBall-v0")
+            pg.display.set_caption("InflatedBall-v1")
             self.clock = pg.time.Clock()
         if self.font is None:
             pg.font.init()
@@ -125,7 +125,7 @@ def frame_strip(out, steps=(0, 30, 36, 42, 90), seed=3):
 
     rows = []
     for mode in ("pressure", "paddle"):
-        env = gym.make("InflatedBall-v0", action_mode=mode, render_mode="rgb_array")
+        env = gym.make("InflatedBall-v1", action_mode=mode, render_mode="rgb_array")
         obs, _ = env.reset(seed=seed)
         config = env.unwrapped.config
         structure = env.unwrapped.observation_structure
@@ -152,6 +152,6 @@ if __name__ == "__main__":
     import os
 
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
-    parser = argparse.ArgumentParser(description="Write a frame strip of InflatedBall-v0 (both modes).")
+    parser = argparse.ArgumentParser(description="Write a frame strip of InflatedBall-v1 (both modes).")
     parser.add_argument("--out", default="docs/env.png", help="PNG file to write")
     print(frame_strip(parser.parse_args().out))

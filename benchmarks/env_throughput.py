@@ -1,4 +1,4 @@
-"""Throughput of InflatedBall-v0: env steps per second per fidelity preset and action mode, the native
+"""Throughput of InflatedBall-v1: env steps per second per fidelity preset and action mode, the native
 vector env against Gymnasium's SyncVectorEnv, and each preset's first-apex error.
 
     python benchmarks/env_throughput.py    # writes benchmarks/results/env_throughput.md and .png
@@ -46,7 +46,7 @@ def controller(env, mode, structure):
 
 
 def single_rate(preset, mode, policy, repeats=3):
-    env = gym.make("InflatedBall-v0", action_mode=mode, fidelity=preset)
+    env = gym.make("InflatedBall-v1", action_mode=mode, fidelity=preset)
     obs, info = env.reset(seed=0)
     ctrl = controller(env, mode, env.unwrapped.observation_structure)
     env.action_space.seed(0)
@@ -69,7 +69,7 @@ def single_rate(preset, mode, policy, repeats=3):
 
 def vector_rate(n_envs, mode, native, repeats=3):
     kind = "vector_entry_point" if native else "sync"
-    venv = gym.make_vec("InflatedBall-v0", num_envs=n_envs, vectorization_mode=kind, action_mode=mode)
+    venv = gym.make_vec("InflatedBall-v1", num_envs=n_envs, vectorization_mode=kind, action_mode=mode)
     rng = np.random.default_rng(0)
     steps = max(1, VECTOR_ENV_STEPS // n_envs)
     venv.reset(seed=0)
@@ -118,7 +118,7 @@ def preset_errors():
 def main():
     RESULTS.mkdir(exist_ok=True)
     lines = [
-        "# InflatedBall-v0 throughput",
+        "# InflatedBall-v1 throughput",
         "",
         f"Single env, {SINGLE_STEPS} steps, best of 3 (env steps/s):",
         "",

@@ -1,13 +1,13 @@
-"""Gymnasium environments: InflatedBall-v0 (single) and its native vector env."""
+"""Gymnasium environments: InflatedBall-v1 (single) and its native vector env."""
 
 from gymnasium.envs.registration import register, registry
 
-ENV_ID = "InflatedBall-v0"
+ENV_ID = "InflatedBall-v1"
 MAX_EPISODE_STEPS = 1000
 
 
 def register_envs():
-    """Register InflatedBall-v0 (repeatable: a second call changes nothing)."""
+    """Register InflatedBall-v1 (repeatable: a second call changes nothing)."""
     if ENV_ID in registry:
         return
     register(

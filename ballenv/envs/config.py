@@ -1,4 +1,4 @@
-"""The keyword arguments of InflatedBall-v0, validated once, and what both envs derive from them:
+"""The keyword arguments of InflatedBall-v1, validated once, and what both envs derive from them:
 the physics scene, the task settings, the observation bounds, and the reward and episode end."""
 
 import math
@@ -24,7 +24,7 @@ FAILURES = {
 
 @dataclass(frozen=True)
 class BallEnvConfig:
-    """Keyword arguments of InflatedBall-v0 (SI units); see the env's Arguments table."""
+    """Keyword arguments of InflatedBall-v1 (SI units); see the env's Arguments table."""
 
     action_mode: str = "pressure"
     fidelity: str = "fast"
@@ -55,7 +55,7 @@ class BallEnvConfig:
     rest_height: float = 0.01
 
     def __post_init__(self):
-        o = "InflatedBall-v0"
+        o = "InflatedBall-v1"
         s = object.__setattr__
         check_choice(o, "action_mode", self.action_mode, tuple(ACTION_MODES))
         check_choice(o, "fidelity", self.fidelity, tuple(FIDELITY_PRESETS))
@@ -166,7 +166,7 @@ class BallEnvConfig:
         unknown = sorted(set(kwargs) - known)
         if unknown:
             raise TypeError(
-                f"InflatedBall-v0 got unknown keyword arguments {unknown}; known: {sorted(known)}"
+                f"InflatedBall-v1 got unknown keyword arguments {unknown}; known: {sorted(known)}"
             )
         return cls(**kwargs)
 
@@ -195,7 +195,7 @@ def parse_actions(actions, count, what):
             return a
     shape = "(1,)" if count == 1 else f"({count}, 1)"
     raise ValueError(
-        f"InflatedBall-v0 {what} = {actions!r} is invalid: must be {count} finite real number"
+        f"InflatedBall-v1 {what} = {actions!r} is invalid: must be {count} finite real number"
         f"{'s' if count > 1 else ''} (shape {shape}; values outside [-1, 1] are clipped)"
     )
 

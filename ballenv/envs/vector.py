@@ -1,6 +1,6 @@
-"""A native vector env of InflatedBall-v0: all balls stepped in one compiled call.
+"""A native vector env of InflatedBall-v1: all balls stepped in one compiled call.
 
-``gym.make_vec("InflatedBall-v0", num_envs=64, vectorization_mode="vector_entry_point", **kwargs)``.
+``gym.make_vec("InflatedBall-v1", num_envs=64, vectorization_mode="vector_entry_point", **kwargs)``.
 Env ``i`` uses the random stream of a single env reset with ``seed + i`` (as ``SyncVectorEnv``
 seeds its envs) and the same compiled step, so it reproduces single envs exactly. Autoreset follows
 Gymnasium's default ``NEXT_STEP`` mode: the step after an episode ends resets that env, ignores its
@@ -29,7 +29,7 @@ DEFAULT_MAX_EPISODE_STEPS = 1000
 
 
 class InflatedBallVectorEnv(VectorEnv):
-    """``num_envs`` InflatedBall-v0 episodes advanced together (see :class:`InflatedBallEnv` for the
+    """``num_envs`` InflatedBall-v1 episodes advanced together (see :class:`InflatedBallEnv` for the
     task, spaces and keyword arguments; ``max_episode_steps`` truncates each episode)."""
 
     metadata = {
@@ -41,7 +41,7 @@ class InflatedBallVectorEnv(VectorEnv):
     def __init__(self, num_envs=1, max_episode_steps=DEFAULT_MAX_EPISODE_STEPS, render_mode=None, **kwargs):
         if isinstance(num_envs, bool) or not isinstance(num_envs, int) or not 1 <= num_envs <= 100_000:
             raise ValueError(
-                f"InflatedBall-v0.num_envs = {num_envs!r} is out of range: must be an integer in [1, 100000]"
+                f"InflatedBall-v1.num_envs = {num_envs!r} is out of range: must be an integer in [1, 100000]"
             )
         if (
             isinstance(max_episode_steps, bool)
@@ -49,12 +49,12 @@ class InflatedBallVectorEnv(VectorEnv):
             or max_episode_steps < 1
         ):
             raise ValueError(
-                f"InflatedBall-v0.max_episode_steps = {max_episode_steps!r} is out of range: must be an "
+                f"InflatedBall-v1.max_episode_steps = {max_episode_steps!r} is out of range: must be an "
                 "integer >= 1"
             )
         if render_mode not in (None, "rgb_array"):
             raise ValueError(
-                f"InflatedBall-v0 vector render_mode = {render_mode!r} is out of range: must be None "
+                f"InflatedBall-v1 vector render_mode = {render_mode!r} is out of range: must be None "
                 "or 'rgb_array'"
             )
         self.config = BallEnvConfig.from_kwargs(kwargs)
@@ -88,7 +88,7 @@ class InflatedBallVectorEnv(VectorEnv):
             seeds = list(seed)
             if len(seeds) != self.num_envs:
                 raise ValueError(
-                    f"InflatedBall-v0 vector reset seed has {len(seeds)} entries: must have "
+                    f"InflatedBall-v1 vector reset seed has {len(seeds)} entries: must have "
                     f"num_envs = {self.num_envs}"
                 )
         for i, s in enumerate(seeds):

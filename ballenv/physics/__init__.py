@@ -1,5 +1,6 @@
 """The inflated-ring simulator: pure numerics (NumPy + numba), no gymnasium, no torch."""
 
+from .compile_notice import install as _install_compile_notice
 from .scene import Ground, Ring, Scene
 from .simulate import simulate
 from .simulation import Simulation, SimulationError, SimulationStats, Trajectory, energy
@@ -15,3 +16,5 @@ __all__ = [
     "energy",
     "simulate",
 ]
+
+_install_compile_notice()

@@ -1,9 +1,13 @@
 """Actuation between steps: the amount of gas in a ring, and impulses on its nodes.
 
-Both change a ring's energy on purpose, so each recomputes what the stepper carries for the ring
-(its energy and free energy for the energy guard, which then compares only steps without
-actuation; its energy budget, raised or lowered by the change; and the generalized-alpha start
-acceleration ``a = F / m``, as at a restart).
+Both change a ring's energy on purpose, so each recomputes the energy the stepper carries for the
+ring (its energy and free energy for the energy guard, which then compares only steps without
+actuation; its energy budget, raised or lowered by the change: :func:`recount_energy`). Both keep
+the integrator's carried acceleration: an actuation is a change of load or velocity between steps,
+which the integrator steps through like any other. (Setting ``a = F / m`` there, as at the start of
+a run, restarted generalized-alpha from a state off its equilibrium at every control step; its
+first step at a large ``omega h`` overshoots, and with random gas commands the energy guard rejected
+1.4 steps per control step.) :func:`restart` is the start of a run: energy and ``a = F / m``.
 
 * :func:`set_rest_pressure`: the gas is set to the amount whose gauge pressure on the ring's inflated
   circle at rest is ``p`` (Pa), i.e. ``(p + p_atm) A_r^k`` with ``A_r`` the area of that circle
@@ -33,11 +37,11 @@ def rest_circle_radius(model, r, pressure, n_nodes):
 
 
 @njit(cache=True)
-def set_rest_pressure(model, r, pressure, x, v, a, active, energy, ws):
+def set_rest_pressure(model, r, pressure, x, v, energy, ws):
     """Set ring ``r``'s gas to the amount with gauge pressure ``pressure`` (Pa) at rest (see module
     doc): updates ``model.gas_constant[r]`` and ``model.rest_energy[r]``, then the ring's carried
-    ``energy`` (3,: energy, free part, budget; see :func:`restart`) and start acceleration ``a``
-    (N, 2) for state ``x, v`` with contact set ``active``. ``ws.xe``/``ws.ve`` are used as scratch."""
+    ``energy`` (columns ``layout.ENERGY``; :func:`recount_energy`) for state ``x, v``.
+    ``ws.xe``/``ws.ve`` are used as scratch."""
     n = x.shape[0]
     radius = rest_circle_radius(model, r, pressure, n)
     circle = ws.xe
@@ -53,12 +57,13 @@ def set_rest_pressure(model, r, pressure, x, v, a, active, energy, ws):
     total = ring_energy(model, r, circle, still, ws.energy)
     g = gravity_column(model)
     model.rest_energy[r] = total - (ws.energy[g] if g >= 0 else 0.0)
-    restart(model, r, x, v, a, active, energy, ws)
+    recount_energy(model, r, x, v, energy, ws)
 
 
 @njit(cache=True)
-def apply_impulse(model, r, x, v, a, active, energy, ws, nodes, count, jx, jy):
-    """Add momentum ``(jx, jy)`` (N s) to ring ``r``, shared equally by ``nodes[:count]``."""
+def apply_impulse(model, r, x, v, energy, ws, nodes, count, jx, jy):
+    """Add momentum ``(jx, jy)`` (N s) to ring ``r``, shared equally by ``nodes[:count]``, and
+    recount its carried ``energy`` (:func:`recount_energy`)."""
     if count == 0:
         return
     dvx = jx / (count * model.node_mass[r])
@@ -67,17 +72,24 @@ def apply_impulse(model, r, x, v, a, active, energy, ws, nodes, count, jx, jy):
         i = nodes[k]
         v[i, 0] += dvx
         v[i, 1] += dvy
-    restart(model, r, x, v, a, active, energy, ws)
+    recount_energy(model, r, x, v, energy, ws)
+
+
+@njit(cache=True)
+def recount_energy(model, r, x, v, energy, ws):
+    """Recompute ring ``r``'s carried energy (columns ``layout.ENERGY``) after an actuation; the
+    change of energy is added to the ring's energy budget."""
+    before = energy[ENERGY_TOTAL]
+    free_energy(model, r, x, v, ws.energy, energy)
+    energy[ENERGY_BUDGET] += energy[ENERGY_TOTAL] - before
 
 
 @njit(cache=True)
 def restart(model, r, x, v, a, active, energy, ws):
-    """Recompute ring ``r``'s carried energy (columns ``layout.ENERGY``) and start acceleration
-    ``a = F / m`` (normal part zeroed on ground-constrained nodes, which rest on the surface) after
-    an actuation; the change of energy is added to the ring's energy budget."""
-    before = energy[ENERGY_TOTAL]
-    free_energy(model, r, x, v, ws.energy, energy)
-    energy[ENERGY_BUDGET] += energy[ENERGY_TOTAL] - before
+    """Start ring ``r`` afresh from ``x, v``: its carried energy (:func:`recount_energy`) and start
+    acceleration ``a = F / m`` (normal part zeroed on ground-constrained nodes, which rest on the
+    surface)."""
+    recount_energy(model, r, x, v, energy, ws)
     ring_force(model, r, x, v, ws.force)
     m = model.node_mass[r]
     for i in range(x.shape[0]):

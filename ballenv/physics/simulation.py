@@ -319,10 +319,7 @@ class Simulation:
         unit = "Pa; the upper bound inflates the wall by 100 %"
         pressure = check_real(owner, "pressure", pressure, 0.0, min(1e8, burst), unit)
         s = self.state
-        set_rest_pressure(
-            self.model, ring, pressure, s.x[ring], s.v[ring], s.a[ring], s.active[ring],
-            s.energy[ring], self.ws,
-        )  # fmt: skip
+        set_rest_pressure(self.model, ring, pressure, s.x[ring], s.v[ring], s.energy[ring], self.ws)
 
     def apply_impulse(self, ring, nodes, impulse):
         """Add momentum ``impulse`` (N s, a pair, each at most 1e3 N s) to ring ``ring``, shared
@@ -344,9 +341,8 @@ class Simulation:
         nodes = chosen.astype(np.int64)
         s = self.state
         apply_impulse(
-            self.model, ring, s.x[ring], s.v[ring], s.a[ring], s.active[ring], s.energy[ring], self.ws,
-            nodes, len(nodes), jx, jy,
-        )  # fmt: skip
+            self.model, ring, s.x[ring], s.v[ring], s.energy[ring], self.ws, nodes, len(nodes), jx, jy
+        )
 
     def stats(self):
         """:class:`SimulationStats` so far."""

@@ -1,4 +1,4 @@
-"""InflatedBall-v0 as Gymnasium and Stable-Baselines3 expect it: checkers, seeding, pickling,
+"""InflatedBall-v1 as Gymnasium and Stable-Baselines3 expect it: checkers, seeding, pickling,
 clear errors (extreme actions: tests/stability/test_env_extreme_actions.py)."""
 
 import pickle
@@ -18,7 +18,7 @@ MODES = ("pressure", "paddle")
 @pytest.mark.parametrize("mode", MODES)
 @pytest.mark.parametrize("render_mode", [None, "rgb_array", "human"])
 def test_gymnasium_check_env_passes_with_warnings_as_errors(mode, render_mode):
-    env = gym.make("InflatedBall-v0", action_mode=mode, render_mode=render_mode)
+    env = gym.make("InflatedBall-v1", action_mode=mode, render_mode=render_mode)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         check_env(env.unwrapped, skip_render_check=False)
@@ -35,12 +35,12 @@ def test_stable_baselines3_check_env_passes(mode):
 
 
 def test_registered_under_both_ids_with_a_time_limit():
-    for env_id in ("InflatedBall-v0", "ballenv:InflatedBall-v0"):
+    for env_id in ("InflatedBall-v1", "ballenv:InflatedBall-v1"):
         env = gym.make(env_id)
         assert env.spec.max_episode_steps == 1000
         assert isinstance(env.unwrapped, InflatedBallEnv)
     ballenv.register_envs()  # repeatable
-    assert gym.spec("InflatedBall-v0").entry_point == "ballenv.envs.inflated_ball:InflatedBallEnv"
+    assert gym.spec("InflatedBall-v1").entry_point == "ballenv.envs.inflated_ball:InflatedBallEnv"
 
 
 def _rollout(env, seed, steps, actions=None):
@@ -61,11 +61,11 @@ def _rollout(env, seed, steps, actions=None):
 
 @pytest.mark.parametrize("mode", MODES)
 def test_same_seed_gives_identical_rollouts(mode):
-    a = _rollout(gym.make("InflatedBall-v0", action_mode=mode), 7, 200)
-    b = _rollout(gym.make("InflatedBall-v0", action_mode=mode), 7, 200)
+    a = _rollout(gym.make("InflatedBall-v1", action_mode=mode), 7, 200)
+    b = _rollout(gym.make("InflatedBall-v1", action_mode=mode), 7, 200)
     np.testing.assert_array_equal(a[0], b[0])
     np.testing.assert_array_equal(a[1], b[1])
-    c = _rollout(gym.make("InflatedBall-v0", action_mode=mode), 8, 200)
+    c = _rollout(gym.make("InflatedBall-v1", action_mode=mode), 8, 200)
     assert not np.array_equal(a[0][0], c[0][0])
 
 
@@ -119,7 +119,7 @@ def test_invalid_action_raises_and_out_of_range_actions_are_clipped():
 def test_rgb_array_render_is_an_image_and_opens_no_window():
     import pygame
 
-    env = gym.make("InflatedBall-v0", action_mode="paddle", render_mode="rgb_array")
+    env = gym.make("InflatedBall-v1", action_mode="paddle", render_mode="rgb_array")
     env.reset(seed=0)
     env.step(np.array([1.0], dtype=np.float32))
     frame = env.render()

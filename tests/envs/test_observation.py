@@ -110,7 +110,7 @@ def _step_until_struck(env, steps=300):
 
 @pytest.mark.parametrize("mode", MODES)
 def test_each_named_slice_holds_what_its_name_says(mode):
-    env = gym.make("InflatedBall-v0", action_mode=mode)
+    env = gym.make("InflatedBall-v1", action_mode=mode)
     structure = env.unwrapped.observation_structure
     obs, info = env.reset(seed=4)
     assert _mismatches(env, obs, info, structure) == []

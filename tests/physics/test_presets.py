@@ -14,8 +14,8 @@ def test_preset_sets_the_numerics_and_keeps_the_physics(name):
     out = with_fidelity(scene, name)
     preset = FIDELITY_PRESETS[name]
     assert out.rings[0].n_nodes == preset["n_nodes"]
-    assert (out.dt, out.impulse_tol, out.newton_tol, out.adaptive) == (
-        preset["dt"], preset["impulse_tol"], preset["newton_tol"], True,
+    assert (out.dt, out.impulse_tol, out.newton_tol, out.rho_infinity, out.adaptive) == (
+        preset["dt"], preset["impulse_tol"], preset["newton_tol"], preset["rho_infinity"], True,
     )  # fmt: skip
     assert out.rings[0].pressure == 20e3 and out.rings[0].youngs_modulus == 5e6
     assert out.grounds == scene.grounds and out.damping == 2.0
