@@ -185,7 +185,8 @@ def table(rows):
         "state; 'rest' = the remainder: predictor, contact bookkeeping, energy guard, events,",
         "observation and reward):",
         "",
-        "| preset | mode | total | Python | dispatch | residuals | Jacobian | factor + solve | rest | us per Newton iteration |",
+        "| preset | mode | total | Python | dispatch | residuals | Jacobian | factor + solve | rest "
+        "| us per Newton iteration |",
         "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for r in rows:

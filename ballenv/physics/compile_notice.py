@@ -47,7 +47,8 @@ class CompileNotice(event.Listener):
         self.depth -= 1
         if self.depth == 0:
             took = time.perf_counter() - self.start
-            print(f"ballenv: compiled {self.name} in {took:.0f} s", file=self.stream or sys.stderr, flush=True)
+            stream = self.stream or sys.stderr
+            print(f"ballenv: compiled {self.name} in {took:.0f} s", file=stream, flush=True)
 
 
 _LISTENER = CompileNotice()
