@@ -2,6 +2,7 @@
 vector env against Gymnasium's SyncVectorEnv, and each preset's first-apex error.
 
     python benchmarks/env_throughput.py    # writes benchmarks/results/env_throughput.md and .png
+    python benchmarks/env_throughput.py --vector    # prints the vector table alone
 
 Single process, numba warm (one warm-up episode), OPENBLAS_NUM_THREADS=1. Policies: "scripted" is
 the heuristic controller of the mode (a ball that keeps bouncing: the workload of a trained agent),
@@ -17,9 +18,11 @@ import os
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import pathlib  # noqa: E402
+import sys  # noqa: E402
 import time  # noqa: E402
 
 import gymnasium as gym  # noqa: E402
+import numba  # noqa: E402
 import numpy as np  # noqa: E402
 from tqdm.auto import tqdm  # noqa: E402
 
@@ -34,6 +37,7 @@ PRESETS = tuple(FIDELITY_PRESETS)
 MODES = ("pressure", "paddle")
 SINGLE_STEPS = 2000
 VECTOR_SIZES = (1, 8, 64)
+VECTOR_KINDS = ("native, 1 thread", "native, all threads", "SyncVectorEnv")
 VECTOR_ENV_STEPS = 6400  # env steps per vector measurement (split over the envs)
 
 
@@ -67,24 +71,62 @@ def single_rate(preset, mode, policy, repeats=3):
     return best
 
 
-def vector_rate(n_envs, mode, native, repeats=3):
-    kind = "vector_entry_point" if native else "sync"
-    venv = gym.make_vec("InflatedBall-v1", num_envs=n_envs, vectorization_mode=kind, action_mode=mode)
-    rng = np.random.default_rng(0)
+def vector_envs(n_envs, mode):
+    """The three vector envs compared: the native one on one thread and on all, and SyncVectorEnv."""
+
+    def native(threads):
+        return gym.make_vec(
+            "InflatedBall-v1", num_envs=n_envs, vectorization_mode="vector_entry_point", action_mode=mode,
+            num_threads=threads,
+        )  # fmt: skip
+
+    sync = gym.make_vec("InflatedBall-v1", num_envs=n_envs, vectorization_mode="sync", action_mode=mode)
+    return dict(zip(VECTOR_KINDS, (native(1), native(None), sync), strict=True))
+
+
+def vector_rates(n_envs, mode, repeats=3):
+    """Env steps/s of each of :func:`vector_envs`, best of ``repeats``; each repeat runs the same
+    seeds and actions through all of them, one after the other (the machine's drifts hit all)."""
+    venvs = vector_envs(n_envs, mode)
     steps = max(1, VECTOR_ENV_STEPS // n_envs)
-    venv.reset(seed=0)
-    for _ in range(5):
-        venv.step(rng.uniform(-1, 1, (n_envs, 1)).astype(np.float32))
-    best = 0.0
-    for rep in range(repeats):
-        venv.reset(seed=rep)
-        actions = rng.uniform(-1, 1, (steps, n_envs, 1)).astype(np.float32)
-        start = time.perf_counter()
-        for a in actions:
-            venv.step(a)
-        best = max(best, steps * n_envs / (time.perf_counter() - start))
-    venv.close()
+    best = dict.fromkeys(venvs, 0.0)
+    for rep in range(-1, repeats):  # rep -1: warm-up
+        actions = np.random.default_rng(rep + 1).uniform(-1, 1, (steps, n_envs, 1)).astype(np.float32)
+        for name, venv in venvs.items():
+            venv.reset(seed=rep + 1)
+            start = time.perf_counter()
+            for a in actions if rep >= 0 else actions[:5]:
+                venv.step(a)
+            if rep >= 0:
+                best[name] = max(best[name], steps * n_envs / (time.perf_counter() - start))
+    for venv in venvs.values():
+        venv.close()
     return best
+
+
+def vector_measurements():
+    """{(mode, envs): rates of :func:`vector_rates`}."""
+    return {
+        (mode, n): vector_rates(n, mode) for mode in MODES for n in tqdm(VECTOR_SIZES, desc=f"vector {mode}")
+    }
+
+
+def vector_table(vector):
+    threads = numba.get_num_threads()
+    lines = [
+        "",
+        f"Vector envs, fast preset, random actions (env steps/s, all envs together; all threads = "
+        f"{threads}):",
+        "",
+        "| mode | envs | native, 1 thread | native, all threads | SyncVectorEnv | threads speed-up | "
+        "native / Sync |",
+        "|---|---:|---:|---:|---:|---:|---:|",
+    ]
+    for (mode, n), rate in vector.items():
+        one, every, sync = (rate[name] for name in VECTOR_KINDS)
+        rates = f"{one:,.0f} | {every:,.0f} | {sync:,.0f}"
+        lines.append(f"| {mode} | {n} | {rates} | {every / one:.2f} | {every / sync:.2f} |")
+    return lines
 
 
 def drop_scene():
@@ -133,15 +175,7 @@ def main():
             )
             s, r = single[preset, mode]
             lines.append(f"| {preset} | {mode} | {s:,.0f} | {r:,.0f} |")
-    lines += ["", "Vector envs, fast preset, random actions (env steps/s, all envs together):", ""]
-    lines += ["| mode | envs | native vector env | SyncVectorEnv | ratio |", "|---|---:|---:|---:|---:|"]
-    vector = {}
-    for mode in MODES:
-        for n in tqdm(VECTOR_SIZES, desc=f"vector {mode}"):
-            native = vector_rate(n, mode, True)
-            sync = vector_rate(n, mode, False)
-            vector[mode, n] = (native, sync)
-            lines.append(f"| {mode} | {n} | {native:,.0f} | {sync:,.0f} | {native / sync:.2f} |")
+    lines += vector_table(vector := vector_measurements())
     errors, reference = preset_errors()
     lines += ["", f"Preset first-apex error (drop from 1 m; reference apex {reference:.5f} m):", ""]
     lines += [
@@ -174,10 +208,9 @@ def plot(single, vector):
     left.set_yscale("log")
     left.legend()
     for mode in MODES:
-        right.plot(VECTOR_SIZES, [vector[mode, n][0] for n in VECTOR_SIZES], "o-", label=f"native, {mode}")
-        right.plot(
-            VECTOR_SIZES, [vector[mode, n][1] for n in VECTOR_SIZES], "s--", label=f"SyncVectorEnv, {mode}"
-        )
+        for name, style in zip(VECTOR_KINDS, ("^:", "o-", "s--"), strict=True):
+            rates = [vector[mode, n][name] for n in VECTOR_SIZES]
+            right.plot(VECTOR_SIZES, rates, style, label=f"{name}, {mode}")
     right.set_xscale("log")
     right.set_xlabel("envs")
     right.set_ylabel("env steps / s (random actions)")
@@ -187,4 +220,7 @@ def plot(single, vector):
 
 
 if __name__ == "__main__":
-    main()
+    if sys.argv[1:] == ["--vector"]:  # the vector table alone
+        print("\n".join(vector_table(vector_measurements())))
+    else:
+        main()

@@ -11,7 +11,9 @@ A control step of env ``e``: apply the action (set the gas, or let the paddle st
 (after a lift-off, before the next touchdown): the centre of mass also turns round inside a squash.
 """
 
+import itertools
 import math
+from concurrent.futures import ThreadPoolExecutor
 from typing import NamedTuple
 
 import numpy as np
@@ -82,6 +84,7 @@ REWARD_SHAPING = REWARD.index("reward_shaping")
 REWARD_TERMINATION = REWARD.index("reward_termination")
 NO_OUTPUT = 1e300  # output interval of advance(): record only at the end of the control step
 EVENT_ROWS = 32
+CHUNKS_PER_THREAD = 8  # a threaded step hands out contiguous chunks of envs to whichever thread is free
 
 
 class Task(NamedTuple):
@@ -256,56 +259,54 @@ def _tally(task, e, events, n_events):
 
 
 @njit(cache=True)
+def step_env(
+    model, solver, ws, state, trial, clocks, counters, records, events, task, e, action, nodes, obs, low,
+    high, out,
+):  # fmt: skip
+    """One control step of env ``e``: actuate with ``action`` in [-1, 1], advance to its next control
+    time, tally its flight apexes, then write its observation (``obs[e]``, unclipped; ``out[e]``,
+    clipped to ``[low, high]`` as float32) and reward and end (``task.reward``, ``task.end``, see
+    :func:`_outcome`). ``ws`` and ``nodes`` are scratch, carried over nothing."""
+    me = env_model(model, e)
+    se = env_state(state, e)
+    te = env_state(trial, e)
+    task.apex_count[e] = 0
+    task.apex_error[e] = 0.0
+    task.apex_height[e] = 0.0
+    _actuate(me, se, task, e, action, ws, nodes)
+    t_next = (task.steps[e] + 1) * task.control_dt
+    rec = Recording(
+        records.t[e], records.x[e], records.v[e], records.pressure[e], records.contact_force[e], events[e]
+    )
+    counters[e, COUNT_RECORDS] = 0
+    while True:
+        counters[e, COUNT_EVENTS] = 0
+        status = advance(me, solver, ws, se, te, clocks[e], counters[e], t_next, t_next, NO_OUTPUT, rec)
+        _tally(task, e, events[e], counters[e, COUNT_EVENTS])
+        if status != STATUS_BUFFER_FULL:
+            break
+    task.status[e] = status
+    task.steps[e] += 1
+    task.rise[e] = _rise(me, se, task, e)
+    observe_env(model, state, task, e, obs[e])
+    _clip(obs[e], low, high, out[e])
+    _outcome(task, e, obs[e], state.x.shape[1])
+
+
+@njit(cache=True, nogil=True)
 def step_batch(
-    model,
-    solver,
-    ws,
-    state,
-    trial,
-    clocks,
-    counters,
-    records,
-    events,
-    task,
-    actions,
-    active,
-    nodes,
-    obs,
-    low,
-    high,
-    out,
-):
-    """One control step of every env ``e`` with ``active[e]``: actuate with ``actions[e]`` in [-1, 1],
-    advance to its next control time, tally its flight apexes, then write its observation (``obs``,
-    unclipped; ``out``, clipped to ``[low, high]`` as float32) and reward and end (``task.reward``,
-    ``task.end``, see :func:`_outcome`)."""
+    model, solver, ws, state, trial, clocks, counters, records, events, task, actions, active, nodes, obs,
+    low, high, out,
+):  # fmt: skip
+    """One control step (:func:`step_env`) of every env ``e`` with ``active[e]``, with action
+    ``actions[e]``, one after the other. Runs without the GIL: threads may step disjoint sets of
+    envs at once, each with its own scratch ``ws``, ``nodes``."""
     for e in range(actions.shape[0]):
-        if not active[e]:
-            continue
-        me = env_model(model, e)
-        se = env_state(state, e)
-        te = env_state(trial, e)
-        task.apex_count[e] = 0
-        task.apex_error[e] = 0.0
-        task.apex_height[e] = 0.0
-        _actuate(me, se, task, e, actions[e], ws, nodes)
-        t_next = (task.steps[e] + 1) * task.control_dt
-        rec = Recording(
-            records.t[e], records.x[e], records.v[e], records.pressure[e], records.contact_force[e], events[e]
-        )
-        counters[e, COUNT_RECORDS] = 0
-        while True:
-            counters[e, COUNT_EVENTS] = 0
-            status = advance(me, solver, ws, se, te, clocks[e], counters[e], t_next, t_next, NO_OUTPUT, rec)
-            _tally(task, e, events[e], counters[e, COUNT_EVENTS])
-            if status != STATUS_BUFFER_FULL:
-                break
-        task.status[e] = status
-        task.steps[e] += 1
-        task.rise[e] = _rise(me, se, task, e)
-        observe_env(model, state, task, e, obs[e])
-        _clip(obs[e], low, high, out[e])
-        _outcome(task, e, obs[e], state.x.shape[1])
+        if active[e]:
+            step_env(
+                model, solver, ws, state, trial, clocks, counters, records, events, task, e, actions[e],
+                nodes, obs, low, high, out,
+            )  # fmt: skip
 
 
 @njit(cache=True)
@@ -392,9 +393,16 @@ class BallBatch:
     """E envs' arrays and the compiled calls that reset and step them.
 
     ``obs`` (E, D) float32 holds the observations clipped to ``[low, high]``; ``task.reward`` the
-    reward and its terms, ``task.end`` how each episode ended (``END_*``)."""
+    reward and its terms, ``task.end`` how each episode ended (``END_*``).
 
-    def __init__(self, scene, n_envs, task_settings, low, high):
+    With ``threads`` > 1 a step is cut into ``CHUNKS_PER_THREAD * threads`` contiguous chunks of
+    envs, each a :func:`step_batch` call (without the GIL) taken by whichever thread (the caller's
+    and ``threads - 1`` others) is free, with that thread's scratch: envs cost unequal and changing
+    amounts (a bounce, a strike), so fixed shares would leave one thread waiting. Chunks write
+    disjoint, contiguous rows (no cache line written by two threads but at chunk ends) and scratch
+    carries nothing from one env to the next: every env's numbers are those of one thread, to the bit."""
+
+    def __init__(self, scene, n_envs, task_settings, low, high, threads=1):
         self.scene = scene
         self.n_envs = n_envs
         self.n_nodes = scene.rings[0].n_nodes
@@ -434,12 +442,23 @@ class BallBatch:
             end=np.zeros(n_envs, dtype=np.int64),
         )
         self.nodes = np.zeros(self.n_nodes, dtype=np.int64)
+        self.threads = max(1, min(int(threads), n_envs))
+        self._pool = None
+        if self.threads > 1:
+            self._pool = ThreadPoolExecutor(self.threads - 1, thread_name_prefix="ballenv")
+            self._scratch = [(self.ws, self.nodes)] + [
+                (build_workspace(self.n_nodes), np.zeros(self.n_nodes, dtype=np.int64))
+                for _ in range(self.threads - 1)
+            ]
+            chunks = min(n_envs, CHUNKS_PER_THREAD * self.threads)
+            chunk = np.arange(n_envs) * chunks // n_envs
+            self._chunks = chunk[None, :] == np.arange(chunks)[:, None]
         self.low = np.asarray(low, dtype=np.float64)
         self.high = np.asarray(high, dtype=np.float64)
         self.raw = np.zeros((n_envs, observation_size(self.n_nodes, self.task.mode)))
         self.obs = np.zeros(self.raw.shape, dtype=np.float32)
         self.all = np.ones(n_envs, dtype=np.bool_)
-        self._step_batch = None  # step_batch's compiled entry point, once known
+        self._step_batch = None  # the compiled entry point of the step call, once known
 
     def reset(self, e, centre, velocity, phase, target, pressure):
         """Start env ``e`` afresh (see :func:`reset_env`)."""
@@ -453,14 +472,41 @@ class BallBatch:
         """One control step of the envs marked in ``active`` (all by default); ``actions`` (E,)
         float64 in [-1, 1]."""
         active = self.all if active is None else np.ascontiguousarray(active, dtype=np.bool_)
+        actions = np.ascontiguousarray(actions, dtype=np.float64)
+        if self._pool is None:
+            self._step(self.ws, self.nodes, actions, active)
+            return
+        if self._step_batch is None:
+            self._step(self.ws, self.nodes, actions, np.zeros_like(active))  # compile or load, once
+        tickets = itertools.count()  # chunk k goes to the thread that draws ticket k
+        calls = [
+            self._pool.submit(self._step_chunks, tickets, actions, active, ws, nodes)
+            for ws, nodes in self._scratch[1:]
+        ]
+        self._step_chunks(tickets, actions, active, *self._scratch[0])
+        for call in calls:
+            call.result()
+
+    def _step_chunks(self, tickets, actions, active, ws, nodes):
+        for k in tickets:
+            if k >= len(self._chunks):
+                return
+            self._step(ws, nodes, actions, active & self._chunks[k])
+
+    def _step(self, ws, nodes, actions, active):
         args = (
-            self.model, self.solver, self.ws, self.state, self.trial, self.clocks, self.counters,
-            self.records, self.records.events, self.task, np.ascontiguousarray(actions, dtype=np.float64),
-            active, self.nodes, self.raw, self.low, self.high, self.obs,
+            self.model, self.solver, ws, self.state, self.trial, self.clocks, self.counters, self.records,
+            self.records.events, self.task, actions, active, nodes, self.raw, self.low, self.high, self.obs,
         )  # fmt: skip
         if self._step_batch is None:
             self._step_batch = compiled_entry(step_batch, args)
         self._step_batch(*args)
+
+    def close(self):
+        """Stop the step threads (if any)."""
+        if self._pool is not None:
+            self._pool.shutdown()
+            self._pool = None
 
 
 def compiled_entry(dispatcher, args):

@@ -315,11 +315,12 @@ def _kick(v, h, node_mass, a, i, b, j, t, nx, ny, signed, delta, relax, kicked):
 
 
 @njit(cache=True)
-def _nearest_own_edge(pred, r, i, step, arc0, best, best_j, best_t):
+def _nearest_own_edge(pred, edge, r, i, step, arc0, best, best_j, best_t):
     """Scan ring ``r``'s edges from node ``i`` along the ring in direction ``step`` (+1 or -1):
     skip the edges whose nearest end lies less than ``arc0`` (m, arc length at the predicted
-    positions ``pred``) from ``i``, then test the next ``SELF_CONTACT_WINDOW``; keep the nearest edge closer
-    than ``sqrt(best)`` at the predicted positions. Returns ``(best, best_j, best_t)``."""
+    positions ``pred``, edge lengths ``edge``) from ``i``, then test the next
+    ``SELF_CONTACT_WINDOW``; keep the nearest edge closer than ``sqrt(best)`` at the predicted
+    positions. Returns ``(best, best_j, best_t)``."""
     n = pred.shape[1]
     px, py = pred[r, i, 0], pred[r, i, 1]
     arc = 0.0
@@ -327,7 +328,7 @@ def _nearest_own_edge(pred, r, i, step, arc0, best, best_j, best_t):
     node = i
     for _ in range(n // 2 - 1):
         far = (node + step) % n
-        arc += math.hypot(pred[r, far, 0] - pred[r, node, 0], pred[r, far, 1] - pred[r, node, 1])
+        arc += edge[node] if step > 0 else edge[far]
         near, node = far, far
         far = (node + step) % n
         if arc < arc0:
@@ -352,18 +353,22 @@ def _nearest_own_edge(pred, r, i, step, arc0, best, best_j, best_t):
 
 
 @njit(cache=True)
-def _self_contacts(x, pred, v, h, r, delta, relax, node_mass, kicked):
+def _self_contacts(x, pred, edge, v, h, r, delta, relax, node_mass, kicked):
     """Impulses between node ``i`` of ring ``r`` and the nearest edge of its own ring closer than
     ``delta`` at the predicted positions, among the ``SELF_CONTACT_WINDOW`` edges on each side that
     begin ``SELF_CONTACT_ARC * delta`` of arc length away from the node (nearer wall cannot touch
     it without a fold sharper than the wall is thick); the normal points to the side the node is on
-    at the step's start. Returns the number of contacts."""
+    at the step's start. ``edge`` (N,) is scratch for the predicted edge lengths (m). Returns the
+    number of contacts."""
     n = x.shape[1]
+    for j in range(n):
+        q = next_node(j, n)
+        edge[j] = math.hypot(pred[r, q, 0] - pred[r, j, 0], pred[r, q, 1] - pred[r, j, 1])
     arc0 = SELF_CONTACT_ARC * delta
     count = 0
     for i in range(n):
-        best, best_j, best_t = _nearest_own_edge(pred, r, i, 1, arc0, delta * delta, -1, 0.0)
-        best, best_j, best_t = _nearest_own_edge(pred, r, i, -1, arc0, best, best_j, best_t)
+        best, best_j, best_t = _nearest_own_edge(pred, edge, r, i, 1, arc0, delta * delta, -1, 0.0)
+        best, best_j, best_t = _nearest_own_edge(pred, edge, r, i, -1, arc0, best, best_j, best_t)
         if best_j < 0:
             continue
         j = best_j
@@ -422,7 +427,9 @@ def collision_impulses(x, v, h, thickness, node_mass, rings, self_contact, cw, k
             )
     if self_contact:
         for r in range(x.shape[0]):
-            count += _self_contacts(x, pred, v, h, r, 2.0 * thickness[r], relax, node_mass, kicked)
+            count += _self_contacts(
+                x, pred, cw.edge_length, v, h, r, 2.0 * thickness[r], relax, node_mass, kicked
+            )
     for r in range(x.shape[0]):
         change = 0.0
         for i in range(x.shape[1]):

@@ -72,6 +72,7 @@ class CollisionWorkspace(NamedTuple):
     kicked: np.ndarray  # (R, N, 2) m/s: start velocities of the step after the collision impulses
     kinetic_change: np.ndarray  # (R,) J: change of each ring's kinetic energy by those impulses
     predicted: np.ndarray  # (R, N, 2) m: x0 + h v0, where the step's contacts are found
+    edge_length: np.ndarray  # (N,) m: a ring's edge lengths at the predicted positions
     box: np.ndarray  # (R, 4) m: xmin, ymin, xmax, ymax
     margin: np.ndarray  # (R,) m: growth of each box in the broad phase
     order: np.ndarray  # (R,) int64: rings by the left edge of their grown box
@@ -238,6 +239,7 @@ def build_collision_workspace(n_rings, n_nodes):
         kicked=np.zeros((n_rings, n_nodes, 2)),
         kinetic_change=np.zeros(n_rings),
         predicted=np.zeros((n_rings, n_nodes, 2)),
+        edge_length=np.zeros(n_nodes),
         box=np.zeros((n_rings, 4)),
         margin=np.zeros(n_rings),
         order=np.arange(n_rings, dtype=np.int64),

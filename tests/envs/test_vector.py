@@ -66,6 +66,24 @@ def test_native_vector_env_matches_single_envs_through_autoresets(mode):
     assert vec[3].sum() >= n_envs  # every env was truncated at least once
 
 
+@pytest.mark.parametrize("mode", ["pressure", "paddle"])
+def test_threads_match_one_thread_bit_for_bit(mode):
+    # 9 envs on 2 threads: chunks of unequal size, taken by whichever thread is free; autoresets
+    n_envs, steps = 9, 160
+    actions = _actions(steps, n_envs, seed=3)
+    runs = []
+    for threads in (1, 2):
+        venv = InflatedBallVectorEnv(
+            num_envs=n_envs, num_threads=threads, action_mode=mode, max_episode_steps=70
+        )
+        assert venv._batch.threads == threads
+        runs.append(_vector_rollouts(venv, 11, actions))
+        venv.close()
+    for one, two in zip(*runs, strict=True):
+        np.testing.assert_array_equal(one, two)
+    assert runs[0][3].sum() >= n_envs  # every env was truncated at least once
+
+
 def test_sync_vector_env_matches_single_envs():
     actions = _actions(120, 2, seed=1)
     venv = gym.make_vec("InflatedBall-v1", num_envs=2, vectorization_mode="sync")
@@ -98,6 +116,8 @@ def test_vector_env_spaces_and_errors():
         venv.step(np.zeros((2, 1), dtype=np.float32))
     with pytest.raises(ValueError, match="num_envs"):
         InflatedBallVectorEnv(num_envs=0)
+    with pytest.raises(ValueError, match=r"num_threads = 0 .* \[1, "):
+        InflatedBallVectorEnv(num_envs=2, num_threads=0)
     frames = InflatedBallVectorEnv(num_envs=2, render_mode="rgb_array")
     frames.reset(seed=0)
     images = frames.render()
