@@ -6,12 +6,13 @@
     python -m agents.evaluate path/to/model.zip --algo sac --env-kwargs '{"action_mode": "paddle"}'
 
 Episode ``k`` is reset with seed ``seed + k`` (default 10,000 on: training uses small seeds), so
-the same arguments give the same numbers. Metrics (the reward's shaping term is ignored):
+the same arguments give the same numbers. Metrics (the reward is the env's training signal; these
+are the task's measures):
 
 * **apex error**: per episode, the mean of ``|h - h_target| / h_target`` over its flight apexes,
   where each apex missed because the episode ended early (the ball came to rest, left the arena or
-  the simulator failed; counted as the env's termination term does, until ``termination_horizon``)
-  counts as an error of 1; reported as the mean over episodes with a 95 % confidence interval
+  the simulator failed) counts as an error of 1: one per flight time ``2 sqrt(2 (h_target - R) /
+  g)`` left until the time limit; reported as the mean over episodes with a 95 % confidence interval
   (normal approximation, ``1.96 s / sqrt(n)``);
 * **success rate**: the fraction of all apexes (missed ones included) within 5 % of the target;
 * **apexes per episode** (missed ones included), **episode length** in control steps, and the mean
@@ -52,6 +53,7 @@ def run_episode(env, policy, seed):
     obs, _ = env.reset(seed=seed)
     policy.reset(seed)
     config = env.unwrapped.config
+    limit = env.spec.max_episode_steps if env.spec and env.spec.max_episode_steps else None
     errors = []
     total = 0.0
     length = 0
@@ -62,10 +64,18 @@ def run_episode(env, policy, seed):
         length += 1
         if info["apex_count"]:
             errors.append(abs(info["apex_height"] - info["target_height"]) / info["target_height"])
-        if terminated and config.termination_reward_weight > 0.0:
-            missed = int(round(-info["reward_termination"] / config.termination_reward_weight))
+        if terminated and limit:
+            missed = missed_apexes(config, info["target_height"], (limit - length) * config.control_dt)
         if terminated or truncated:
             return errors, missed, length, total
+
+
+def missed_apexes(config, target, time_left):
+    """Apexes a ball bouncing to ``target`` (m) would reach in ``time_left`` (s): one per flight
+    time ``2 sqrt(2 (target - R) / g)``, ``R`` the unstretched radius (the centre of a resting ball
+    is about that high)."""
+    flight = 2.0 * math.sqrt(2.0 * max(target - config.radius, 1e-3) / config.gravity)
+    return int(round(max(time_left, 0.0) / flight))
 
 
 def evaluate(policy, env_kwargs=None, episodes=20, seed=DEFAULT_SEED, algo=None, progress=False):

@@ -62,6 +62,7 @@ from .observation import (
     OBS_PADDLE_IMPULSE,
     OBS_PADDLE_IN_REACH,
     OBS_PRESSURE,
+    OBS_PRESSURE_SETPOINT,
     OBS_TARGET_HEIGHT,
     field_start,
 )
@@ -75,13 +76,14 @@ END_REST = 1
 END_ARENA = 2
 END_FAILURE = 3
 END_REASONS = ("", "rest", "arena", "sim_failure")
-REWARD_TERMS = ("reward_apex", "reward_shaping", "reward_termination")  # the terms' info keys
+REWARD_TERMS = ("reward_height",)  # the terms' info keys
 # columns of Task.reward: the reward, then its terms in the order of REWARD_TERMS
 REWARD = Layout("total", *REWARD_TERMS)
 REWARD_TOTAL = REWARD.index("total")
-REWARD_APEX = REWARD.index("reward_apex")
-REWARD_SHAPING = REWARD.index("reward_shaping")
-REWARD_TERMINATION = REWARD.index("reward_termination")
+REWARD_HEIGHT = REWARD.index("reward_height")
+# the tolerance reward is 0.1 at a relative error of reward_margin (DeepMind Control's gaussian)
+REWARD_AT_MARGIN = 0.1
+REWARD_SCALE = math.sqrt(-2.0 * math.log(REWARD_AT_MARGIN))
 NO_OUTPUT = 1e300  # output interval of advance(): record only at the end of the control step
 EVENT_ROWS = 32
 CHUNKS_PER_THREAD = 8  # a threaded step hands out contiguous chunks of envs to whichever thread is free
@@ -100,13 +102,10 @@ class Task(NamedTuple):
     paddle_depth: float  # m: it touches the nodes within this of the ball's top
     ground_height: float  # m
     gravity: float  # m/s^2
-    apex_weight: float
-    shaping_weight: float  # per second
-    termination_weight: float  # per missed apex
+    reward_margin: float  # relative apex error at which the reward has fallen to REWARD_AT_MARGIN
     arena_half_width: float  # m
     arena_height: float  # m
     rest_height: float  # m
-    termination_horizon: float  # s: the termination term counts apexes missed until this time
     target: np.ndarray  # (E,) m, target apex height of the centre of mass
     setpoint: np.ndarray  # (E,) Pa, gas amount as gauge pressure at rest
     rest_radius: np.ndarray  # (E,) m, radius of the inflated circle at the setpoint
@@ -316,18 +315,36 @@ def _clip(row, low, high, out):
 
 
 @njit(cache=True)
+def predicted_apex(task, e, row, n):
+    """Height (m) of the apex the ball is headed for, from env ``e``'s observation ``row``: in
+    flight (no ground contact since the last lift-off) the centre of mass's ballistic apex ``y +
+    v_y^2 / (2 g)``, exact (only gravity acts on the centre); in contact the apex its free energy
+    could reach, ``r + rise`` (the pump's work ``p dA`` on a squashed ball counts)."""
+    if not task.airborne[e]:
+        return task.rest_radius[e] + task.rise[e]
+    cy = row[field_start(OBS_CENTRE_OF_MASS_POSITION, n) + 1]
+    vy = row[field_start(OBS_CENTRE_OF_MASS_VELOCITY, n) + 1]
+    return cy + 0.5 * vy * vy / task.gravity
+
+
+@njit(cache=True)
+def height_reward(error, margin):
+    """DeepMind Control's gaussian ``tolerance``: 1 at relative error 0, ``REWARD_AT_MARGIN`` at
+    ``margin``, ``exp(-(s error / margin)^2 / 2)`` with ``s = sqrt(-2 ln REWARD_AT_MARGIN)``; in
+    (0, 1]."""
+    x = REWARD_SCALE * error / margin
+    return math.exp(-0.5 * x * x)
+
+
+@njit(cache=True)
 def _outcome(task, e, row, n):
-    """Reward terms and end of env ``e`` after a control step (see ``InflatedBallEnv``'s Rewards):
-    apex ``-w sum |h - h_t| / h_t``; shaping ``-w dt |h_reach - h_t| / h_t`` with ``h_reach = r +
-    rise``; termination ``-w`` per apex left until ``termination_horizon`` (one per flight time
-    ``2 sqrt(2 (h_t - r) / g)``) when the ball rests, leaves the arena or the simulator fails."""
+    """Reward and end of env ``e`` after a control step (see ``InflatedBallEnv``'s Rewards): the
+    :func:`height_reward` of the relative error ``|h - h_t| / h_t`` of the :func:`predicted_apex`
+    ``h``, 0 once the simulator failed; the episode ends when the ball rests, leaves the arena or
+    the simulator fails."""
     centre = field_start(OBS_CENTRE_OF_MASS_POSITION, n)
     cx = row[centre]
     cy = row[centre + 1]
-    target = task.target[e]
-    apex = -task.apex_weight * task.apex_error[e]
-    reach = task.rest_radius[e] + task.rise[e]
-    shaping = -task.shaping_weight * task.control_dt * abs(reach - target) / target
     end = END_NONE
     if task.status[e] != STATUS_DONE or cy < -1.0:
         end = END_FAILURE
@@ -335,16 +352,13 @@ def _outcome(task, e, row, n):
         end = END_ARENA
     elif task.rise[e] < task.rest_height:
         end = END_REST
-    termination = 0.0
-    if end != END_NONE:
-        flight = 2.0 * math.sqrt(2.0 * max(target - task.rest_radius[e], 1e-3) / task.gravity)
-        left = max(task.termination_horizon - task.steps[e] * task.control_dt, 0.0) / flight
-        termination = -task.termination_weight * left
+    target = task.target[e]
+    height = 0.0
+    if end != END_FAILURE:
+        height = height_reward(abs(predicted_apex(task, e, row, n) - target) / target, task.reward_margin)
     task.end[e] = end
-    task.reward[e, REWARD_TOTAL] = apex + shaping + termination
-    task.reward[e, REWARD_APEX] = apex
-    task.reward[e, REWARD_SHAPING] = shaping
-    task.reward[e, REWARD_TERMINATION] = termination
+    task.reward[e, REWARD_TOTAL] = height
+    task.reward[e, REWARD_HEIGHT] = height
 
 
 @njit(cache=True)
@@ -372,6 +386,7 @@ def observe_env(model, state, task, e, row):
     row[centre_velocity] = ux
     row[centre_velocity + 1] = uy
     row[field_start(OBS_PRESSURE, n)] = ring_pressure(env_model(model, e), 0, x)
+    row[field_start(OBS_PRESSURE_SETPOINT, n)] = task.setpoint[e]
     row[field_start(OBS_TARGET_HEIGHT, n)] = task.target[e]
     if task.mode == MODE_PADDLE:
         row[field_start(OBS_PADDLE_HEIGHT, n)] = task.paddle_height[e]

@@ -45,10 +45,7 @@ class BallEnvConfig:
     friction: float = 0.5
     damping: float = 20.0
     gravity: float = 9.81
-    apex_reward_weight: float = 1.0
-    shaping_reward_weight: float = 0.0
-    termination_reward_weight: float = 1.0
-    termination_horizon: float = 10.0
+    reward_margin: float = 0.5
     reset_noise_scale: float = 0.05
     arena_half_width: float = 3.0
     arena_height: float = 5.0
@@ -71,14 +68,12 @@ class BallEnvConfig:
             ("paddle_depth", 0.0, 10.0, "m"),
             ("friction", 0.0, 10.0, ""),
             ("damping", 0.0, 1e4, "1/s"),
-            ("apex_reward_weight", 0.0, 1e6, ""),
-            ("shaping_reward_weight", 0.0, 1e6, ""),
-            ("termination_reward_weight", 0.0, 1e6, ""),
             ("reset_noise_scale", 0.0, 10.0, "m/s"),
             ("rest_height", 0.0, 1.0, "m"),
-            ("termination_horizon", 0.0, 1e6, "s"),
         ):
             s(self, name, check_real(o, name, getattr(self, name), lo, hi, unit))
+        margin = check_real(o, "reward_margin", self.reward_margin, 0.0, 100.0, "", low_open=True)
+        s(self, "reward_margin", margin)
         s(self, "gravity", check_real(o, "gravity", self.gravity, 0.0, 1000.0, "m/s^2", low_open=True))
         s(self, "arena_half_width", check_real(o, "arena_half_width", self.arena_half_width, 0.1, 1e4, "m"))
         s(self, "arena_height", check_real(o, "arena_height", self.arena_height, 0.1, 1e4, "m"))
@@ -140,13 +135,10 @@ class BallEnvConfig:
             "paddle_depth": self.paddle_depth,
             "ground_height": 0.0,
             "gravity": self.gravity,
-            "apex_weight": self.apex_reward_weight,
-            "shaping_weight": self.shaping_reward_weight,
-            "termination_weight": self.termination_reward_weight,
+            "reward_margin": self.reward_margin,
             "arena_half_width": self.arena_half_width,
             "arena_height": self.arena_height,
             "rest_height": self.rest_height,
-            "termination_horizon": self.termination_horizon,
         }
 
     def largest_radius(self):

@@ -70,6 +70,11 @@ FIELDS = (
         "current gauge pressure of the gas",
     ),
     Field(
+        "pressure_setpoint", 0, 1, lambda c: min(c.pressure_range[0], c.initial_pressure),
+        lambda c: max(c.pressure_range[1], c.initial_pressure), "Pa",
+        "the gas amount as gauge pressure at rest (moves toward the command)",
+    ),
+    Field(
         "target_height", 0, 1, lambda c: c.target_height_range[0], lambda c: c.target_height_range[1], "m",
         "this episode's target apex height of the centre of mass",
     ),
@@ -109,6 +114,7 @@ OBS_CENTRE_OF_MASS_POSITION = _START["centre_of_mass_position"]
 OBS_CENTRE_OF_MASS_VELOCITY = _START["centre_of_mass_velocity"]
 OBS_GROUND_NORMAL_FORCE = _START["ground_normal_force"]
 OBS_PRESSURE = _START["pressure"]
+OBS_PRESSURE_SETPOINT = _START["pressure_setpoint"]
 OBS_TARGET_HEIGHT = _START["target_height"]
 OBS_PADDLE_HEIGHT = _START["paddle_height"]
 OBS_PADDLE_IN_REACH = _START["paddle_in_reach"]

@@ -29,7 +29,7 @@ def test_slices_tile_the_vector_without_gaps_or_overlaps(n_nodes, paddle):
         assert part.start == end and part.stop > part.start and part.step is None, name
         end = part.stop
     assert end == observation.size(n_nodes, paddle)
-    assert end == 5 * n_nodes + 6 + (3 if paddle else 0)  # the docstring's "(5 N + 6,)" and "+3"
+    assert end == 5 * n_nodes + 7 + (3 if paddle else 0)  # the docstring's "(5 N + 7,)" and "+3"
 
 
 @pytest.mark.parametrize("paddle", [False, True])
