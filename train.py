@@ -52,8 +52,8 @@ def parse_args(argv=None):
     )  # fmt: skip
     p.add_argument("--seed", type=int, default=0, help="seed of the run (envs get seed, seed + 1, ...)")
     p.add_argument("--total-timesteps", type=int, default=None, help="env steps (default: from the YAML)")
-    p.add_argument("--eval-freq", type=int, default=20_000, help="env steps between evaluations")
-    p.add_argument("--eval-episodes", type=int, default=3, help="episodes per periodic evaluation")
+    p.add_argument("--eval-freq", type=int, default=40_000, help="env steps between evaluations")
+    p.add_argument("--eval-episodes", type=int, default=5, help="episodes per periodic evaluation")
     p.add_argument("--final-episodes", type=int, default=10, help="held-out episodes of the final scores")
     p.add_argument("--log-dir", default="runs", help="parent folder of the run folder")
     p.add_argument("--no-baselines", action="store_true", help="score only the trained agent at the end")

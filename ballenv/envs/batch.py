@@ -97,7 +97,7 @@ class Task(NamedTuple):
     pressure_low: float  # Pa, gauge pressure at rest for action -1
     pressure_high: float  # Pa, for action +1
     pressure_rate: float  # Pa/s: the gas setpoint moves toward the command at most this fast
-    paddle_max_impulse: float  # N s, for action +1
+    paddle_max_impulse: float  # N s, for action +1 (actions <= 0: no strike)
     paddle_reach: float  # m: the paddle strikes when the ball's top is within this of its height
     paddle_depth: float  # m: it touches the nodes within this of the ball's top
     ground_height: float  # m
@@ -230,7 +230,7 @@ def _actuate(me, se, task, e, action, ws, nodes):
     for i in range(n):
         top = max(top, x[i, 1])
     task.in_reach[e] = abs(top - task.paddle_height[e]) <= task.paddle_reach
-    impulse = 0.5 * (action + 1.0) * task.paddle_max_impulse
+    impulse = max(action, 0.0) * task.paddle_max_impulse
     if not task.in_reach[e] or impulse <= 0.0:
         return
     count = 0

@@ -26,7 +26,7 @@ class InflatedBallEnv(Env, EzPickle):
     | Mode     | Action a in [-1, 1] sets                                                     | Unit  |
     |----------|------------------------------------------------------------------------------|-------|
     | pressure | the gas amount, as the gauge pressure at rest p = p_lo + (a + 1)/2 (p_hi - p_lo) | Pa |
-    | paddle   | the downward impulse J = (a + 1)/2 * paddle_max_impulse, delivered if in reach | N s |
+    | paddle   | the downward impulse J = max(a, 0) * paddle_max_impulse, delivered if in reach | N s |
 
     Pressure: the gas setpoint moves toward the commanded value at most ``pressure_rate`` (a pump's
     flow; instant jumps of the gas ring the ball's breathing mode like a bell) and is applied at the
@@ -118,7 +118,8 @@ class InflatedBallEnv(Env, EzPickle):
       the apex the ball is headed for (was: apex errors at the apexes, an optional shaping term,
       a penalty per apex missed by ending early; ``apex_reward_weight``, ``shaping_reward_weight``,
       ``termination_reward_weight`` and ``termination_horizon`` replaced by ``reward_margin``).
-      The observation gains ``pressure_setpoint`` (the pump's state; 5 N + 7 entries). v0 is no
+      The observation gains ``pressure_setpoint`` (the pump's state; 5 N + 7 entries). The paddle
+      strikes ``max(a, 0) * paddle_max_impulse`` (was ``(a + 1) / 2 * ...``). v0 is no
       longer registered.
     - v0: initial release.
     """
