@@ -122,4 +122,10 @@ def make_policy(spec, env, algo=None):
         return RandomPolicy(env)
     if spec == "heuristic":
         return HeuristicPolicy(env)
-    return ModelPolicy(env, spec, algo)
+    path = pathlib.Path(spec)
+    if not path.exists():
+        raise ValueError(
+            f"agents.evaluate: policy = {str(spec)!r} is invalid: must be 'random', 'heuristic', a saved "
+            "model (.zip) or a train.py run folder (no such file or folder)"
+        )
+    return ModelPolicy(env, path, algo)

@@ -1,6 +1,6 @@
 """Score a policy on InflatedBall-v1 over held-out episodes.
 
-    python -m agents.evaluate heuristic --action-mode pressure --episodes 20
+    ballenv-evaluate heuristic --action-mode pressure --episodes 20   # or python -m agents.evaluate
     python -m agents.evaluate random --action-mode paddle
     python -m agents.evaluate runs/ppo_pressure_seed0          # a run folder of train.py
     python -m agents.evaluate path/to/model.zip --algo sac --env-kwargs '{"action_mode": "paddle"}'
@@ -140,7 +140,7 @@ def parse_env_kwargs(text):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m agents.evaluate", description=__doc__.split("\n")[0])
+    parser = argparse.ArgumentParser(prog="ballenv-evaluate", description=__doc__.split("\n")[0])
     parser.add_argument("policy", help='"random", "heuristic", a model .zip or a run folder of train.py')
     parser.add_argument("--action-mode", choices=("pressure", "paddle"), help="shortcut for env_kwargs")
     parser.add_argument("--env-kwargs", type=parse_env_kwargs, default=None, help="JSON object")
@@ -154,7 +154,10 @@ def main(argv=None):
         env_kwargs = _run_env_kwargs(args.policy)
     if args.action_mode:
         env_kwargs["action_mode"] = args.action_mode
-    score = evaluate(args.policy, env_kwargs, args.episodes, args.seed, args.algo, progress=True)
+    try:
+        score = evaluate(args.policy, env_kwargs, args.episodes, args.seed, args.algo, progress=True)
+    except ValueError as err:  # a policy or env keyword the user mistyped
+        parser.error(str(err))
     print(table([score]))
     if args.json:
         with open(args.json, "w") as f:

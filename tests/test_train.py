@@ -9,6 +9,7 @@ import pytest
 import yaml
 
 from agents.evaluate import evaluate, main
+from agents.train import main as train_main
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 SHORT = {"max_episode_steps": 60}  # gym.make's time limit: short episodes for the tests
@@ -65,3 +66,20 @@ def test_evaluate_command_line(tmp_path, capsys):
     assert json.loads(out.read_text())["episodes"] == 2
     with pytest.raises(SystemExit):
         main(["heuristic", "--env-kwargs", "[1, 2]"])
+
+
+def test_a_hyperparameter_typo_is_one_readable_line_and_leaves_no_run_folder(tmp_path):
+    with pytest.raises(SystemExit) as stop:
+        train_main(["--hyperparams", '{"n_step": 64}', "--log-dir", str(tmp_path / "runs")])
+    message = str(stop.value.code)
+    assert message.startswith("ballenv-train: error: unknown PPO hyperparameter 'n_step'")
+    assert "did you mean 'n_steps'?" in message
+    assert not (tmp_path / "runs").exists()
+
+
+def test_a_mistyped_policy_names_the_choices(capsys):
+    with pytest.raises(ValueError, match="policy = 'heuristc' is invalid: must be 'random', 'heuristic'"):
+        evaluate("heuristc", {"max_episode_steps": 5}, episodes=1)
+    with pytest.raises(SystemExit):
+        main(["heuristc", "--episodes", "1"])
+    assert "policy = 'heuristc' is invalid" in capsys.readouterr().err

@@ -1,0 +1,279 @@
+"""Train a Stable-Baselines3 agent on InflatedBall-v1, then score it next to the baselines.
+
+    python train.py --algo ppo --action-mode pressure            # the README's main command
+    python train.py --algo sac --action-mode paddle --total-timesteps 50000 --seed 3
+    ballenv-train --algo ppo --env-kwargs '{"fidelity": "balanced"}' --n-envs 2   # when installed
+
+Hyperparameters come from ``agents/hyperparams/{algo}.yml`` (keyed by env id and action mode; the
+command line overrides the budget, the number of envs and the env keyword arguments). A run writes
+one folder ``{log_dir}/{algo}_{mode}_seed{seed}[_k]`` holding:
+
+* ``config.yml`` (algorithm, hyperparameters, env keyword arguments, seed, versions) and
+  ``command.txt`` (the exact command);
+* ``model.zip`` and ``vecnormalize.pkl`` (final), ``best_model.zip`` and ``best_vecnormalize.pkl``
+  (best periodic evaluation), ``checkpoints/``, ``evaluations.npz``, Monitor logs and TensorBoard
+  logs (``tensorboard --logdir runs``);
+* ``scores.md`` / ``scores.json``: the best model, the heuristic and random actions scored by
+  ``agents.evaluate`` on the same held-out seeds, and ``learning_curve.png``.
+"""
+
+import argparse
+import difflib
+import inspect
+import json
+import pathlib
+import shlex
+import sys
+import time
+from dataclasses import asdict
+
+import numpy as np
+import yaml
+
+ENV_ID = "ballenv:InflatedBall-v1"
+HYPERPARAMS = pathlib.Path(__file__).parent / "hyperparams"
+RUN_KEYS = ("n_timesteps", "n_envs", "policy", "normalize", "env_kwargs")
+
+
+def parse_args(argv=None):
+    from .evaluate import parse_env_kwargs
+
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--algo", choices=("ppo", "sac"), default="ppo", help="algorithm (default ppo)")
+    p.add_argument(
+        "--action-mode", choices=("pressure", "paddle"), default="pressure", help="env action mode"
+    )
+    p.add_argument("--env-kwargs", type=parse_env_kwargs, default=None, help="JSON object of env keywords")
+    p.add_argument(
+        "--hyperparams", type=parse_env_kwargs, default=None, help="JSON object overriding the YAML"
+    )
+    p.add_argument("--n-envs", type=int, default=None, help="parallel envs (default: from the YAML)")
+    p.add_argument(
+        "--vec-env", choices=("subproc", "dummy"), default="dummy",
+        help="subproc: one process per env (uses the cores); dummy: all in this process",
+    )  # fmt: skip
+    p.add_argument("--seed", type=int, default=0, help="seed of the run (envs get seed, seed + 1, ...)")
+    p.add_argument("--total-timesteps", type=int, default=None, help="env steps (default: from the YAML)")
+    p.add_argument("--eval-freq", type=int, default=40_000, help="env steps between evaluations")
+    p.add_argument("--eval-episodes", type=int, default=5, help="episodes per periodic evaluation")
+    p.add_argument("--final-episodes", type=int, default=10, help="held-out episodes of the final scores")
+    p.add_argument("--log-dir", default="runs", help="parent folder of the run folder")
+    p.add_argument("--no-baselines", action="store_true", help="score only the trained agent at the end")
+    return p.parse_args(argv)
+
+
+def load_hyperparams(algo, mode):
+    """The YAML entry of ``algo`` for InflatedBall-v1 and ``mode`` (a dict)."""
+    table = yaml.safe_load((HYPERPARAMS / f"{algo}.yml").read_text())
+    return dict(table["InflatedBall-v1"][mode])
+
+
+def run_folder(log_dir, algo, mode, seed):
+    base = pathlib.Path(log_dir) / f"{algo}_{mode}_seed{seed}"
+    path, k = base, 1
+    while path.exists():
+        k += 1
+        path = base.with_name(f"{base.name}_{k}")
+    path.mkdir(parents=True)
+    return path
+
+
+def make_envs(env_kwargs, n_envs, seed, normalize, gamma, monitor_dir=None, training=True, subproc=False):
+    import gymnasium as gym
+    from stable_baselines3.common.env_util import make_vec_env
+    from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecNormalize
+
+    compile_once(gym, env_kwargs)
+    envs = make_vec_env(
+        ENV_ID, n_envs=n_envs, seed=seed, env_kwargs=env_kwargs,
+        vec_env_cls=SubprocVecEnv if subproc and n_envs > 1 else DummyVecEnv,
+        monitor_dir=None if monitor_dir is None else str(monitor_dir),
+    )  # fmt: skip
+    if normalize:
+        envs = VecNormalize(envs, norm_obs=True, norm_reward=training, gamma=gamma, training=training)
+    return envs
+
+
+def compile_once(gym, env_kwargs):
+    """Reset and step one env here, before any worker process starts: numba compiles the simulator
+    once (or loads it from its cache) and the workers load it from the cache instead of each
+    compiling it."""
+    env = gym.make(ENV_ID, **env_kwargs)
+    env.reset(seed=0)
+    env.step(env.action_space.sample())
+    env.close()
+
+
+def callbacks(run, eval_env, args, n_envs, total):
+    from stable_baselines3.common.callbacks import BaseCallback, CheckpointCallback, EvalCallback
+
+    class SaveNormalization(BaseCallback):
+        """Save the VecNormalize statistics with each new best model."""
+
+        def _on_step(self):
+            env = self.model.get_vec_normalize_env()
+            if env is not None:
+                env.save(str(run / "best_vecnormalize.pkl"))
+            return True
+
+    class ProgressBar(BaseCallback):
+        """A tqdm bar over env steps (SB3's own needs the `rich` package)."""
+
+        def _on_training_start(self):
+            from tqdm.auto import tqdm
+
+            self.bar = tqdm(total=total, unit="step", desc=f"train {args.algo}", smoothing=0.1)
+
+        def _on_step(self):
+            self.bar.n = self.num_timesteps
+            self.bar.refresh() if self.n_calls % 50 == 0 else None
+            return True
+
+        def _on_training_end(self):
+            self.bar.n = self.num_timesteps
+            self.bar.close()
+
+    every = max(args.eval_freq // n_envs, 1)
+    evaluation = EvalCallback(
+        eval_env, best_model_save_path=str(run), log_path=str(run), eval_freq=every,
+        n_eval_episodes=args.eval_episodes, deterministic=True, callback_on_new_best=SaveNormalization(),
+        verbose=0,
+    )  # fmt: skip
+    checkpoints = CheckpointCallback(
+        save_freq=max(total // (5 * n_envs), 1), save_path=str(run / "checkpoints"), name_prefix="model",
+        save_vecnormalize=True,
+    )  # fmt: skip
+    return [evaluation, checkpoints, ProgressBar()]
+
+
+class UsageError(ValueError):
+    """A command-line or hyperparameter mistake: reported in one line, before any run folder exists."""
+
+
+def check_hyperparams(cls, algo_kwargs):
+    """Raise :class:`UsageError` naming every key of ``algo_kwargs`` that the algorithm ``cls``
+    does not take (with the nearest valid names)."""
+    taken = inspect.signature(cls.__init__).parameters
+    valid = sorted(p for p in taken if p not in ("self", "env", "policy"))
+    unknown = sorted(set(algo_kwargs) - set(valid))
+    if unknown:
+        hints = []
+        for key in unknown:
+            near = difflib.get_close_matches(key, valid, 1)
+            hints.append(f"{key!r} (did you mean {near[0]!r}?)" if near else repr(key))
+        raise UsageError(
+            f"unknown {cls.__name__} hyperparameter {', '.join(hints)}; valid: {', '.join(valid)} "
+            f"(and the run keys {', '.join(RUN_KEYS)})"
+        )
+
+
+def main(argv=None):
+    """``python train.py ...`` / ``ballenv-train ...``: train, save and score (see the module doc)."""
+    try:
+        train(parse_args(argv))
+    except UsageError as err:
+        sys.exit(f"ballenv-train: error: {err}")
+
+
+def train(args):
+    """Train, save and score; returns the run folder."""
+    import stable_baselines3
+    import torch
+    from stable_baselines3 import PPO, SAC
+
+    hp = load_hyperparams(args.algo, args.action_mode)
+    hp.update(args.hyperparams or {})
+    env_kwargs = dict(hp.get("env_kwargs") or {})
+    env_kwargs.update(args.env_kwargs or {})
+    env_kwargs["action_mode"] = args.action_mode
+    n_envs = args.n_envs or int(hp.get("n_envs", 1))
+    total = args.total_timesteps or int(hp["n_timesteps"])
+    normalize = bool(hp.get("normalize", True))
+    algo_kwargs = {k: v for k, v in hp.items() if k not in RUN_KEYS}
+    cls = {"ppo": PPO, "sac": SAC}[args.algo]
+    check_hyperparams(cls, algo_kwargs)
+    gamma = float(algo_kwargs.get("gamma", 0.99))
+
+    run = run_folder(args.log_dir, args.algo, args.action_mode, args.seed)
+    config = {
+        "algo": args.algo, "env_id": ENV_ID, "env_kwargs": env_kwargs, "seed": args.seed,
+        "total_timesteps": total, "n_envs": n_envs, "normalize": normalize,
+        "policy": hp.get("policy", "MlpPolicy"),
+        "hyperparams": algo_kwargs, "eval_freq": args.eval_freq, "eval_episodes": args.eval_episodes,
+        "vec_env": args.vec_env,
+        "versions": {"stable_baselines3": str(stable_baselines3.__version__),
+                     "torch": str(torch.__version__)},
+    }  # fmt: skip
+    (run / "config.yml").write_text(yaml.safe_dump(config, sort_keys=False))
+    (run / "command.txt").write_text(shlex.join([sys.executable, *sys.argv]) + "\n")
+    torch.set_num_threads(1)
+
+    envs = make_envs(
+        env_kwargs, n_envs, args.seed, normalize, gamma, run / "monitor", subproc=args.vec_env == "subproc"
+    )
+    eval_env = make_envs(env_kwargs, 1, args.seed + 1000, normalize, gamma, training=False)
+    model = cls(
+        config["policy"], envs, seed=args.seed, tensorboard_log=str(run / "tensorboard"), device="cpu",
+        verbose=0, **algo_kwargs,
+    )  # fmt: skip
+    start = time.perf_counter()
+    model.learn(total_timesteps=total, callback=callbacks(run, eval_env, args, n_envs, total))
+    wall = time.perf_counter() - start
+    model.save(run / "model")
+    if normalize:
+        envs.save(str(run / "vecnormalize.pkl"))
+    envs.close()
+    eval_env.close()
+    print(f"trained {args.algo} for {model.num_timesteps} env steps in {wall:.0f} s "
+          f"({wall / model.num_timesteps * 1e5:.0f} s per 100k steps); run folder {run}")  # fmt: skip
+    score(run, args, env_kwargs, wall, model.num_timesteps)
+    return run
+
+
+def score(run, args, env_kwargs, wall, steps):
+    """Score the best model and the baselines on the same held-out seeds; write tables and a plot."""
+    from .evaluate import evaluate, table
+
+    best = run / "best_model.zip"
+    policy = best if best.exists() else run / "model.zip"
+    specs = [str(policy)] + ([] if args.no_baselines else ["heuristic", "random"])
+    scores = [evaluate(s, env_kwargs, args.final_episodes, algo=args.algo, progress=True) for s in specs]
+    scores[0] = type(scores[0])(**{**asdict(scores[0]), "policy": f"{args.algo} ({policy.name})"})
+    text = table(scores)
+    print(text)
+    header = f"{args.algo}, {args.action_mode} mode, {steps} env steps in {wall:.0f} s, seed {args.seed}\n\n"
+    (run / "scores.md").write_text(header + text + "\n")
+    (run / "scores.json").write_text(json.dumps([asdict(s) for s in scores], indent=2))
+    plot_learning_curve(run, scores)
+    print(f"wrote {run / 'scores.md'} and {run / 'learning_curve.png'}")
+
+
+def plot_learning_curve(run, scores):
+    """Mean evaluation return against env steps, with the baselines' mean returns as lines."""
+    data = run / "evaluations.npz"
+    if not data.exists():
+        return
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    log = np.load(data)
+    steps, returns = log["timesteps"], log["results"]
+    fig, ax = plt.subplots(figsize=(6, 4))
+    mean, std = returns.mean(axis=1), returns.std(axis=1)
+    ax.plot(steps, mean, "o-", label="trained (periodic evaluation)")
+    ax.fill_between(steps, mean - std, mean + std, alpha=0.2)
+    for s, color in zip(scores[1:], ("tab:green", "tab:red"), strict=False):
+        ax.axhline(s.episode_return, color=color, ls="--", label=f"{s.policy} (held-out episodes)")
+    ax.set_xlabel("env steps")
+    ax.set_ylabel("episode return")
+    ax.set_title(run.name)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(run / "learning_curve.png", dpi=120)
+    plt.close(fig)
+
+
+if __name__ == "__main__":
+    main()
