@@ -498,9 +498,11 @@ class BallBatch:
             self._pool.submit(self._step_chunks, tickets, actions, active, ws, nodes)
             for ws, nodes in self._scratch[1:]
         ]
-        self._step_chunks(tickets, actions, active, *self._scratch[0])
-        for call in calls:
-            call.result()
+        try:
+            self._step_chunks(tickets, actions, active, *self._scratch[0])
+        finally:  # every thread done before this returns or raises
+            for call in calls:
+                call.result()
 
     def _step_chunks(self, tickets, actions, active, ws, nodes):
         for k in tickets:
