@@ -2,7 +2,8 @@
 
 * ``agents.baselines``: random actions and the scripted heuristics of ``ballenv.controllers``
   (pressure pumping, paddle dribbling), and a saved Stable-Baselines3 model, behind one interface.
-* ``agents/hyperparams/{ppo,sac}.yml``: hyperparameters keyed by env id and action mode
-  (RL Baselines3 Zoo style), read by ``train.py``.
-* ``agents.evaluate``: the score of any of them on held-out seeds (``python -m agents.evaluate``).
+* ``agents/hyperparams/{ppo,sac}.yml``: hyperparameters in the RL Baselines3 Zoo format, one entry
+  per env id (one id per action mode), read by ``agents.train``.
+* ``agents.evaluate``: the score of any of them on held-out seeds (``ballenv-evaluate``).
+* ``agents.train``: training and scoring (``python train.py``, ``ballenv-train``).
 """

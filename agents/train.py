@@ -4,8 +4,8 @@
     python train.py --algo sac --action-mode paddle --total-timesteps 50000 --seed 3
     ballenv-train --algo ppo --env-kwargs '{"fidelity": "balanced"}' --n-envs 2   # when installed
 
-Hyperparameters come from ``agents/hyperparams/{algo}.yml`` (keyed by env id and action mode; the
-command line overrides the budget, the number of envs and the env keyword arguments). A run writes
+Hyperparameters come from ``agents/hyperparams/{algo}.yml`` (one entry per env id, i.e. per action
+mode; the command line overrides the budget, the number of envs and the env keyword arguments). A run writes
 one folder ``{log_dir}/{algo}_{mode}_seed{seed}[_k]`` holding:
 
 * ``config.yml`` (algorithm, hyperparameters, env keyword arguments, seed, versions) and
@@ -30,7 +30,6 @@ from dataclasses import asdict
 import numpy as np
 import yaml
 
-ENV_ID = "ballenv:InflatedBall-v1"
 HYPERPARAMS = pathlib.Path(__file__).parent / "hyperparams"
 RUN_KEYS = ("n_timesteps", "n_envs", "policy", "normalize", "env_kwargs")
 
@@ -62,10 +61,20 @@ def parse_args(argv=None):
     return p.parse_args(argv)
 
 
+def env_id(mode):
+    """The registered id of action mode ``mode`` (``ballenv.envs.ENV_IDS``), module-qualified so that
+    spawned workers import ballenv."""
+    from ballenv.envs import ENV_IDS
+
+    return f"ballenv:{ENV_IDS[mode]}"
+
+
 def load_hyperparams(algo, mode):
-    """The YAML entry of ``algo`` for InflatedBall-v1 and ``mode`` (a dict)."""
+    """The YAML entry of ``algo`` for the env id of action mode ``mode`` (a dict)."""
+    from ballenv.envs import ENV_IDS
+
     table = yaml.safe_load((HYPERPARAMS / f"{algo}.yml").read_text())
-    return dict(table["InflatedBall-v1"][mode])
+    return dict(table[ENV_IDS[mode]])
 
 
 def run_folder(log_dir, algo, mode, seed):
@@ -85,7 +94,7 @@ def make_envs(env_kwargs, n_envs, seed, normalize, gamma, monitor_dir=None, trai
 
     compile_once(gym, env_kwargs)
     envs = make_vec_env(
-        ENV_ID, n_envs=n_envs, seed=seed, env_kwargs=env_kwargs,
+        env_id(env_kwargs["action_mode"]), n_envs=n_envs, seed=seed, env_kwargs=env_kwargs,
         vec_env_cls=SubprocVecEnv if subproc and n_envs > 1 else DummyVecEnv,
         monitor_dir=None if monitor_dir is None else str(monitor_dir),
     )  # fmt: skip
@@ -98,7 +107,7 @@ def compile_once(gym, env_kwargs):
     """Reset and step one env here, before any worker process starts: numba compiles the simulator
     once (or loads it from its cache) and the workers load it from the cache instead of each
     compiling it."""
-    env = gym.make(ENV_ID, **env_kwargs)
+    env = gym.make(env_id(env_kwargs["action_mode"]), **env_kwargs)
     env.reset(seed=0)
     env.step(env.action_space.sample())
     env.close()
@@ -196,7 +205,7 @@ def train(args):
 
     run = run_folder(args.log_dir, args.algo, args.action_mode, args.seed)
     config = {
-        "algo": args.algo, "env_id": ENV_ID, "env_kwargs": env_kwargs, "seed": args.seed,
+        "algo": args.algo, "env_id": env_id(args.action_mode), "env_kwargs": env_kwargs, "seed": args.seed,
         "total_timesteps": total, "n_envs": n_envs, "normalize": normalize,
         "policy": hp.get("policy", "MlpPolicy"),
         "hyperparams": algo_kwargs, "eval_freq": args.eval_freq, "eval_episodes": args.eval_episodes,

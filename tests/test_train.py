@@ -39,6 +39,8 @@ def test_train_runs_end_to_end_and_the_saved_agent_reloads(algo, mode, tmp_path)
     assert any((run / "tensorboard").rglob("events.out.tfevents*"))
     config = yaml.safe_load((run / "config.yml").read_text())
     assert config["seed"] == 3 and config["algo"] == algo and config["env_kwargs"]["action_mode"] == mode
+    ids = {"pressure": "ballenv:InflatedBall-v1", "paddle": "ballenv:InflatedBallPaddle-v1"}
+    assert config["env_id"] == ids[mode]
     assert "--total-timesteps 256" in (run / "command.txt").read_text()
     scores = json.loads((run / "scores.json").read_text())
     assert [s["policy"] for s in scores][1:] == ["heuristic", "random"]

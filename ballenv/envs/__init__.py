@@ -1,18 +1,24 @@
-"""Gymnasium environments: InflatedBall-v1 (single) and its native vector env."""
+"""Gymnasium environments: InflatedBall-v1 (single) and its native vector env, registered once per
+action mode (one id per mode, as the RL Baselines3 Zoo keys its hyperparameters)."""
 
 from gymnasium.envs.registration import register, registry
 
 ENV_ID = "InflatedBall-v1"
+PADDLE_ENV_ID = "InflatedBallPaddle-v1"  # InflatedBall-v1 with action_mode="paddle"
+ENV_IDS = {"pressure": ENV_ID, "paddle": PADDLE_ENV_ID}  # action mode -> its env id
 MAX_EPISODE_STEPS = 1000
 
 
 def register_envs():
-    """Register InflatedBall-v1 (repeatable: a second call changes nothing)."""
-    if ENV_ID in registry:
-        return
-    register(
-        id=ENV_ID,
-        entry_point="ballenv.envs.inflated_ball:InflatedBallEnv",
-        vector_entry_point="ballenv.envs.vector:InflatedBallVectorEnv",
-        max_episode_steps=MAX_EPISODE_STEPS,
-    )
+    """Register the ids of ``ENV_IDS`` (repeatable: a second call changes nothing). Each sets its
+    action mode through the spec's ``kwargs``; a keyword passed to ``gym.make`` overrides it."""
+    for mode, env_id in ENV_IDS.items():
+        if env_id in registry:
+            continue
+        register(
+            id=env_id,
+            entry_point="ballenv.envs.inflated_ball:InflatedBallEnv",
+            vector_entry_point="ballenv.envs.vector:InflatedBallVectorEnv",
+            max_episode_steps=MAX_EPISODE_STEPS,
+            kwargs={"action_mode": mode},
+        )

@@ -43,6 +43,16 @@ def test_registered_under_both_ids_with_a_time_limit():
     assert gym.spec("InflatedBall-v1").entry_point == "ballenv.envs.inflated_ball:InflatedBallEnv"
 
 
+def test_one_id_per_action_mode_and_a_keyword_overrides_it():
+    assert gym.make("InflatedBall-v1").unwrapped.config.action_mode == "pressure"
+    paddle = gym.make("ballenv:InflatedBallPaddle-v1")
+    assert paddle.unwrapped.config.action_mode == "paddle" and paddle.spec.max_episode_steps == 1000
+    assert "paddle_height" in paddle.unwrapped.observation_structure
+    assert gym.make("InflatedBall-v1", action_mode="paddle").unwrapped.config.action_mode == "paddle"
+    venv = gym.make_vec("InflatedBallPaddle-v1", num_envs=2, vectorization_mode="vector_entry_point")
+    assert venv.unwrapped.config.action_mode == "paddle"
+
+
 def _rollout(env, seed, steps, actions=None):
     obs, _ = env.reset(seed=seed)
     env.action_space.seed(seed)
