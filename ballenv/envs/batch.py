@@ -19,7 +19,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from ..physics.actuation import apply_impulse, rest_circle_radius, restart, set_rest_pressure
+from ..physics.actuation import apply_impulse, rest_circle_radius, restart, set_gas, set_rest_pressure
 from ..physics.contact import FREE
 from ..physics.effects.gas import ring_pressure
 from ..physics.geometry import centre_of_mass
@@ -176,7 +176,7 @@ def reset_env(
         se.contact_force[0, i, 0] = 0.0
         se.contact_force[0, i, 1] = 0.0
     if model.pressurised[e]:
-        set_rest_pressure(me, 0, pressure, x, v, se.energy[0], ws)
+        set_gas(me, 0, pressure, n, ws)  # restart() counts the energy
     restart(me, 0, x, v, se.a[0], se.active[0], se.energy[0], ws)
     se.energy[0, ENERGY_BUDGET] = se.energy[0, ENERGY_TOTAL]  # a new episode starts a new budget
     clocks[e, :] = 0.0

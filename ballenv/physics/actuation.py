@@ -38,11 +38,18 @@ def rest_circle_radius(model, r, pressure, n_nodes):
 
 @njit(cache=True)
 def set_rest_pressure(model, r, pressure, x, v, energy, ws):
-    """Set ring ``r``'s gas to the amount with gauge pressure ``pressure`` (Pa) at rest (see module
-    doc): updates ``model.gas_constant[r]`` and ``model.rest_energy[r]``, then the ring's carried
-    ``energy`` (columns ``layout.ENERGY``; :func:`recount_energy`) for state ``x, v``.
-    ``ws.xe``/``ws.ve`` are used as scratch."""
-    n = x.shape[0]
+    """Set ring ``r``'s gas to the amount with gauge pressure ``pressure`` (Pa) at rest
+    (:func:`set_gas`), then recount its carried ``energy`` (columns ``layout.ENERGY``;
+    :func:`recount_energy`) for state ``x, v``."""
+    set_gas(model, r, pressure, x.shape[0], ws)
+    recount_energy(model, r, x, v, energy, ws)
+
+
+@njit(cache=True)
+def set_gas(model, r, pressure, n, ws):
+    """The gas amount of ring ``r`` (``n`` nodes) whose gauge pressure on its inflated circle at rest
+    is ``pressure`` (Pa) (see module doc): updates ``model.gas_constant[r]`` and
+    ``model.rest_energy[r]`` only. ``ws.xe``/``ws.ve`` are used as scratch."""
     radius = rest_circle_radius(model, r, pressure, n)
     circle = ws.xe
     still = ws.ve
@@ -57,7 +64,6 @@ def set_rest_pressure(model, r, pressure, x, v, energy, ws):
     total = ring_energy(model, r, circle, still, ws.energy)
     g = gravity_column(model)
     model.rest_energy[r] = total - (ws.energy[g] if g >= 0 else 0.0)
-    recount_energy(model, r, x, v, energy, ws)
 
 
 @njit(cache=True)

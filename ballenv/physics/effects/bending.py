@@ -62,6 +62,15 @@ def _turning_angle(x, i, n):
 
 
 @njit(cache=True)
+def _direction_gradients(e1x, e1y, e2x, e2y):
+    """``g(e1)``, ``g(e2)`` with ``g(e) = (-e_y, e_x) / |e|^2`` (the gradient of the edge's direction
+    angle, 1/m), and ``|e1|^2``, ``|e2|^2``."""
+    s1 = e1x * e1x + e1y * e1y
+    s2 = e2x * e2x + e2y * e2y
+    return -e1y / s1, e1x / s1, -e2y / s2, e2x / s2, s1, s2
+
+
+@njit(cache=True)
 def bend_energy(x, rest_len, ei, rest_turn):
     """Bending energy (J) of the ring."""
     n = x.shape[0]
@@ -84,10 +93,7 @@ def bend_force(x, rest_len, ei, rest_turn, f):
     k = ei / rest_len
     for i in range(n):
         phi, e1x, e1y, e2x, e2y = _turning_angle(x, i, n)
-        s1 = e1x * e1x + e1y * e1y
-        s2 = e2x * e2x + e2y * e2y
-        g1x, g1y = -e1y / s1, e1x / s1
-        g2x, g2y = -e2y / s2, e2x / s2
+        g1x, g1y, g2x, g2y = _direction_gradients(e1x, e1y, e2x, e2y)[:4]
         m = -k * (phi - rest_turn)
         p = prev_node(i, n)
         q = next_node(i, n)
@@ -111,11 +117,8 @@ def bend_jacobian(x, rest_len, ei, rest_turn, coef, band, pos):
     k = ei / rest_len
     for i in range(n):
         phi, e1x, e1y, e2x, e2y = _turning_angle(x, i, n)
-        s1 = e1x * e1x + e1y * e1y
-        s2 = e2x * e2x + e2y * e2y
         # gradient blocks: node a in (prev, i, next)
-        gpx, gpy = -e1y / s1, e1x / s1
-        gnx, gny = -e2y / s2, e2x / s2
+        gpx, gpy, gnx, gny, s1, s2 = _direction_gradients(e1x, e1y, e2x, e2y)
         gix, giy = -gpx - gnx, -gpy - gny
         c = -coef * k
         t = phi - rest_turn

@@ -51,15 +51,23 @@ def energy(model, p, r, x, v):
 
 
 @njit(cache=True)
+def _edge(x, i, n, rest_len):
+    """Edge ``(i, i + 1)``: its end node ``j``, vector ``(dx, dy)`` and length (m), and strain
+    ``eps = |e| / l0 - 1``."""
+    j = next_node(i, n)
+    dx = x[j, 0] - x[i, 0]
+    dy = x[j, 1] - x[i, 1]
+    length = math.sqrt(dx * dx + dy * dy)
+    return j, dx, dy, length, length / rest_len - 1.0
+
+
+@njit(cache=True)
 def stretch_energy(x, rest_len, ea):
     """Stretching energy (J) of the ring."""
     n = x.shape[0]
     e = 0.0
     for i in range(n):
-        j = next_node(i, n)
-        dx = x[j, 0] - x[i, 0]
-        dy = x[j, 1] - x[i, 1]
-        eps = math.sqrt(dx * dx + dy * dy) / rest_len - 1.0
+        eps = _edge(x, i, n, rest_len)[4]
         e += 0.5 * ea * eps * eps * rest_len
     return e
 
@@ -69,11 +77,7 @@ def stretch_force(x, rest_len, ea, f):
     """Add the stretching forces (N) to ``f`` (N, 2)."""
     n = x.shape[0]
     for i in range(n):
-        j = next_node(i, n)
-        dx = x[j, 0] - x[i, 0]
-        dy = x[j, 1] - x[i, 1]
-        length = math.sqrt(dx * dx + dy * dy)
-        eps = length / rest_len - 1.0
+        j, dx, dy, length, eps = _edge(x, i, n, rest_len)
         s = ea * eps / length
         f[i, 0] += s * dx
         f[i, 1] += s * dy
@@ -90,11 +94,7 @@ def stretch_jacobian(x, rest_len, ea, coef, band, pos):
     """
     n = x.shape[0]
     for i in range(n):
-        j = next_node(i, n)
-        dx = x[j, 0] - x[i, 0]
-        dy = x[j, 1] - x[i, 1]
-        length = math.sqrt(dx * dx + dy * dy)
-        eps = length / rest_len - 1.0
+        j, dx, dy, length, eps = _edge(x, i, n, rest_len)
         ux = dx / length
         uy = dy / length
         a = ea / rest_len

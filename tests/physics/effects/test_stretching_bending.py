@@ -48,12 +48,15 @@ def test_stretch_jacobian_matches_finite_differences(n_nodes, seed):
     assert relative_error(asm.dense(), fd) < 1e-6
 
 
+def _bent_ring(n_nodes, seed):
+    """A deformed ring, its rest edge length (m) and rest turning angle (rad) of the regular polygon."""
+    return deformed_ring(n_nodes, seed=seed), 2 * RADIUS * np.sin(np.pi / n_nodes), 2 * np.pi / n_nodes
+
+
 @pytest.mark.parametrize("n_nodes", [3, 8, 64])
 @pytest.mark.parametrize("seed", [0, 1])
 def test_bend_force_is_minus_energy_gradient(n_nodes, seed):
-    x = deformed_ring(n_nodes, seed=seed)
-    l0 = 2 * RADIUS * np.sin(np.pi / n_nodes)
-    phi0 = 2 * np.pi / n_nodes
+    x, l0, phi0 = _bent_ring(n_nodes, seed)
     grad = finite_difference_gradient(lambda y: bend_energy(y, l0, EI, phi0), x, 1e-7)
     assert relative_error(_force(bend_force, l0, EI, phi0)(x), -grad) < 1e-6
 
@@ -61,9 +64,7 @@ def test_bend_force_is_minus_energy_gradient(n_nodes, seed):
 @pytest.mark.parametrize("n_nodes", [3, 8, 64])
 @pytest.mark.parametrize("seed", [0, 1])
 def test_bend_jacobian_matches_finite_differences(n_nodes, seed):
-    x = deformed_ring(n_nodes, seed=seed)
-    l0 = 2 * RADIUS * np.sin(np.pi / n_nodes)
-    phi0 = 2 * np.pi / n_nodes
+    x, l0, phi0 = _bent_ring(n_nodes, seed)
     asm = DenseAssembler(n_nodes)
     bend_jacobian(x, l0, EI, phi0, 2.5, asm.band, asm.pos)
     fd = finite_difference_jacobian(_force(bend_force, l0, EI, phi0), x, 1e-7)
