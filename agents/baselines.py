@@ -16,6 +16,7 @@ from ballenv.controllers import PaddleDribble, PressurePump
 from ballenv.physics.ring import total_mass
 
 ALGORITHMS = ("ppo", "sac")
+HEURISTIC_PARAMS = pathlib.Path(__file__).parent / "hyperparams" / "heuristic.yml"
 
 
 class RandomPolicy:
@@ -34,19 +35,22 @@ class RandomPolicy:
 
 
 class HeuristicPolicy:
-    """The scripted controller of the env's action mode (pressure pumping or paddle dribbling)."""
+    """The scripted controller of the env's action mode (pressure pumping or paddle dribbling), with
+    the parameters ``params`` (default: the tuned ones of ``hyperparams/heuristic.yml`` for the env's
+    id, see ``agents.tune``; the controller's own defaults where the file has no entry)."""
 
     name = "heuristic"
 
-    def __init__(self, env):
+    def __init__(self, env, params=None):
         config = env.unwrapped.config
         structure = env.unwrapped.observation_structure
+        params = tuned_heuristic(config.action_mode) if params is None else dict(params)
         if config.action_mode == "pressure":
-            self.controller = PressurePump(structure, gravity=config.gravity)
+            self.controller = PressurePump(structure, gravity=config.gravity, **params)
         else:
             mass = total_mass(config.ring(config.initial_pressure))
             self.controller = PaddleDribble(
-                structure, mass, gravity=config.gravity, max_impulse=config.paddle_max_impulse
+                structure, mass, gravity=config.gravity, max_impulse=config.paddle_max_impulse, **params
             )
 
     def reset(self, seed):
@@ -54,6 +58,16 @@ class HeuristicPolicy:
 
     def act(self, obs):
         return self.controller.act(obs)
+
+
+def tuned_heuristic(mode):
+    """The scripted controller's tuned parameters for action mode ``mode`` (a dict; empty if none)."""
+    import yaml
+
+    from ballenv.envs import ENV_IDS
+
+    table = yaml.safe_load(HEURISTIC_PARAMS.read_text()) if HEURISTIC_PARAMS.exists() else {}
+    return dict((table or {}).get(ENV_IDS[mode]) or {})
 
 
 class ModelPolicy:
@@ -117,7 +131,10 @@ def _algo_of(path):
 
 
 def make_policy(spec, env, algo=None):
-    """``"random"``, ``"heuristic"`` or a path to a saved model / run folder -> a policy."""
+    """``"random"``, ``"heuristic"``, a path to a saved model / run folder, or a callable ``env ->
+    policy`` -> a policy."""
+    if callable(spec):
+        return spec(env)
     if spec == "random":
         return RandomPolicy(env)
     if spec == "heuristic":

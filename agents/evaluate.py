@@ -46,6 +46,7 @@ class Score:
     episode_length: float  # mean, control steps
     episode_return: float  # mean
     apexes: float  # mean per episode, missed ones included
+    episode_apex_errors: tuple = ()  # each episode's apex error, in seed order
 
 
 def run_episode(env, policy, seed):
@@ -79,8 +80,9 @@ def missed_apexes(config, target, time_left):
 
 
 def evaluate(policy, env_kwargs=None, episodes=20, seed=DEFAULT_SEED, algo=None, progress=False):
-    """Score ``policy`` ("random", "heuristic", or a saved model / run folder) over ``episodes``
-    episodes of ``gym.make(ENV_ID, **env_kwargs)`` seeded ``seed, seed + 1, ...``."""
+    """Score ``policy`` ("random", "heuristic", a saved model / run folder, or a callable ``env ->
+    policy``) over ``episodes`` episodes of ``gym.make(ENV_ID, **env_kwargs)`` seeded ``seed, seed +
+    1, ...``."""
     env = gym.make(ENV_ID, **(env_kwargs or {}))
     agent = make_policy(policy, env, algo)
     per_episode, hits, apexes, lengths, returns = [], 0, 0, [], []
@@ -101,7 +103,7 @@ def evaluate(policy, env_kwargs=None, episodes=20, seed=DEFAULT_SEED, algo=None,
     err = np.array(per_episode)
     half = 1.96 * err.std(ddof=1) / math.sqrt(len(err)) if len(err) > 1 else math.nan
     return Score(
-        policy=agent.name if policy in ("random", "heuristic") else str(policy),
+        policy=agent.name if policy in ("random", "heuristic") or callable(policy) else str(policy),
         episodes=episodes,
         apex_error=float(err.mean()),
         apex_error_ci95=float(half),
@@ -109,6 +111,7 @@ def evaluate(policy, env_kwargs=None, episodes=20, seed=DEFAULT_SEED, algo=None,
         episode_length=float(np.mean(lengths)),
         episode_return=float(np.mean(returns)),
         apexes=apexes / episodes,
+        episode_apex_errors=tuple(float(e) for e in err),
     )
 
 

@@ -55,7 +55,9 @@ def parse_args(argv=None):
     p.add_argument("--total-timesteps", type=int, default=None, help="env steps (default: from the YAML)")
     p.add_argument("--eval-freq", type=int, default=40_000, help="env steps between evaluations")
     p.add_argument("--eval-episodes", type=int, default=5, help="episodes per periodic evaluation")
-    p.add_argument("--final-episodes", type=int, default=10, help="held-out episodes of the final scores")
+    p.add_argument(
+        "--final-episodes", type=int, default=10, help="held-out episodes of the final scores (0: none)"
+    )
     p.add_argument("--log-dir", default="runs", help="parent folder of the run folder")
     p.add_argument("--no-baselines", action="store_true", help="score only the trained agent at the end")
     return p.parse_args(argv)
@@ -113,7 +115,7 @@ def compile_once(gym, env_kwargs):
     env.close()
 
 
-def callbacks(run, eval_env, args, n_envs, total):
+def callbacks(run, eval_env, args, n_envs, total, on_evaluation=None):
     from stable_baselines3.common.callbacks import BaseCallback, CheckpointCallback, EvalCallback
 
     class SaveNormalization(BaseCallback):
@@ -142,11 +144,18 @@ def callbacks(run, eval_env, args, n_envs, total):
             self.bar.n = self.num_timesteps
             self.bar.close()
 
+    class AfterEvaluation(BaseCallback):
+        """Hand each periodic evaluation to ``on_evaluation(env steps, mean return)``; its False
+        stops the training (a pruned tuning trial)."""
+
+        def _on_step(self):
+            return bool(on_evaluation(self.num_timesteps, float(self.parent.last_mean_reward)))
+
     every = max(args.eval_freq // n_envs, 1)
     evaluation = EvalCallback(
         eval_env, best_model_save_path=str(run), log_path=str(run), eval_freq=every,
         n_eval_episodes=args.eval_episodes, deterministic=True, callback_on_new_best=SaveNormalization(),
-        verbose=0,
+        callback_after_eval=None if on_evaluation is None else AfterEvaluation(), verbose=0,
     )  # fmt: skip
     checkpoints = CheckpointCallback(
         save_freq=max(total // (5 * n_envs), 1), save_path=str(run / "checkpoints"), name_prefix="model",
@@ -184,8 +193,10 @@ def main(argv=None):
         sys.exit(f"ballenv-train: error: {err}")
 
 
-def train(args):
-    """Train, save and score; returns the run folder."""
+def train(args, on_evaluation=None):
+    """Train, save and score (unless ``args.final_episodes`` is 0); returns the run folder.
+    ``on_evaluation(env steps, mean return)`` sees each periodic evaluation; its False stops the
+    training."""
     import stable_baselines3
     import torch
     from stable_baselines3 import PPO, SAC
@@ -226,7 +237,7 @@ def train(args):
         verbose=0, **algo_kwargs,
     )  # fmt: skip
     start = time.perf_counter()
-    model.learn(total_timesteps=total, callback=callbacks(run, eval_env, args, n_envs, total))
+    model.learn(total_timesteps=total, callback=callbacks(run, eval_env, args, n_envs, total, on_evaluation))
     wall = time.perf_counter() - start
     model.save(run / "model")
     if normalize:
@@ -235,7 +246,8 @@ def train(args):
     eval_env.close()
     print(f"trained {args.algo} for {model.num_timesteps} env steps in {wall:.0f} s "
           f"({wall / model.num_timesteps * 1e5:.0f} s per 100k steps); run folder {run}")  # fmt: skip
-    score(run, args, env_kwargs, wall, model.num_timesteps)
+    if args.final_episodes > 0:
+        score(run, args, env_kwargs, wall, model.num_timesteps)
     return run
 
 

@@ -56,6 +56,7 @@ from .observation import (
     OBS_CENTRE_OF_MASS_POSITION,
     OBS_CENTRE_OF_MASS_VELOCITY,
     OBS_GROUND_NORMAL_FORCE,
+    OBS_LAST_APEX,
     OBS_NODE_POSITION,
     OBS_NODE_VELOCITY,
     OBS_PADDLE_HEIGHT,
@@ -111,12 +112,14 @@ class Task(NamedTuple):
     rest_radius: np.ndarray  # (E,) m, radius of the inflated circle at the setpoint
     paddle_height: np.ndarray  # (E,) m
     airborne: np.ndarray  # (E,) bool: no ground contact since the last lift-off
+    last_apex: np.ndarray  # (E,) m: height of the last flight apex (the start height after a reset)
     steps: np.ndarray  # (E,) int64 control steps taken
     apex_count: np.ndarray  # (E,) int64 flight apexes in the last control step
     apex_error: np.ndarray  # (E,) sum of |h - target| / target over them
     apex_height: np.ndarray  # (E,) m, the last of them (0 if none)
     impulse: np.ndarray  # (E,) N s delivered by the paddle in the last control step
-    in_reach: np.ndarray  # (E,) bool: the paddle could strike at the start of the last step
+    in_reach: np.ndarray  # (E,) bool: the paddle can strike at the next step (see _paddle_ready)
+    struck: np.ndarray  # (E,) bool: the paddle struck since the ball last touched the ground
     status: np.ndarray  # (E,) int64 stepper status of the last control step
     rise: np.ndarray  # (E,) m: height the ball could still rise (free energy over m g)
     reward: np.ndarray  # (E, REWARD.size): the reward and its terms (columns REWARD)
@@ -187,12 +190,14 @@ def reset_env(
     task.rest_radius[e] = radius
     task.paddle_height[e] = target + radius
     task.airborne[e] = True
+    task.last_apex[e] = centre[1] - task.ground_height  # released at rest: the start is an apex
     task.steps[e] = 0
     task.apex_count[e] = 0
     task.apex_error[e] = 0.0
     task.apex_height[e] = 0.0
     task.impulse[e] = 0.0
-    task.in_reach[e] = False
+    task.struck[e] = False
+    task.in_reach[e] = _paddle_ready(task, e, x)
     task.status[e] = STATUS_DONE
     task.rise[e] = _rise(me, se, task, e)
     task.reward[e, :] = 0.0
@@ -212,11 +217,29 @@ def _rise(me, se, task, e):
 
 
 @njit(cache=True)
+def _top(x):
+    """Height (m) of the highest node."""
+    top = -math.inf
+    for i in range(x.shape[0]):
+        top = max(top, x[i, 1])
+    return top
+
+
+@njit(cache=True)
+def _paddle_ready(task, e, x):
+    """Whether the paddle can strike env ``e``'s ball at positions ``x``: paddle mode, the ball's top
+    within ``paddle_reach`` of the paddle, and no strike yet since the ball last touched the ground
+    (one strike per flight, as a hand dribbles)."""
+    if task.mode != MODE_PADDLE or task.struck[e]:
+        return False
+    return abs(_top(x) - task.paddle_height[e]) <= task.paddle_reach
+
+
+@njit(cache=True)
 def _actuate(me, se, task, e, action, ws, nodes):
     x = se.x[0]
     n = x.shape[0]
     task.impulse[e] = 0.0
-    task.in_reach[e] = False
     if task.mode == MODE_PRESSURE:
         command = task.pressure_low + 0.5 * (action + 1.0) * (task.pressure_high - task.pressure_low)
         most = task.pressure_rate * task.control_dt
@@ -226,13 +249,10 @@ def _actuate(me, se, task, e, action, ws, nodes):
             task.setpoint[e] = pressure
             task.rest_radius[e] = rest_circle_radius(me, 0, pressure, n)
         return
-    top = -math.inf
-    for i in range(n):
-        top = max(top, x[i, 1])
-    task.in_reach[e] = abs(top - task.paddle_height[e]) <= task.paddle_reach
     impulse = max(action, 0.0) * task.paddle_max_impulse
     if not task.in_reach[e] or impulse <= 0.0:
         return
+    top = _top(x)
     count = 0
     for i in range(n):
         if x[i, 1] >= top - task.paddle_depth:
@@ -240,6 +260,7 @@ def _actuate(me, se, task, e, action, ws, nodes):
             count += 1
     apply_impulse(me, 0, x, se.v[0], se.energy[0], ws, nodes, count, 0.0, -impulse)
     task.impulse[e] = impulse
+    task.struck[e] = True
 
 
 @njit(cache=True)
@@ -248,6 +269,7 @@ def _tally(task, e, events, n_events):
         kind = int(events[k, EVENT_KIND])
         if kind == EVENT_TOUCHDOWN:
             task.airborne[e] = False
+            task.struck[e] = False
         elif kind == EVENT_LIFTOFF:
             task.airborne[e] = True
         elif kind == EVENT_APEX and task.airborne[e]:
@@ -255,6 +277,7 @@ def _tally(task, e, events, n_events):
             task.apex_count[e] += 1
             task.apex_error[e] += abs(h - task.target[e]) / task.target[e]
             task.apex_height[e] = h
+            task.last_apex[e] = h
 
 
 @njit(cache=True)
@@ -287,6 +310,7 @@ def step_env(
     task.status[e] = status
     task.steps[e] += 1
     task.rise[e] = _rise(me, se, task, e)
+    task.in_reach[e] = _paddle_ready(task, e, se.x[0])
     observe_env(model, state, task, e, obs[e])
     _clip(obs[e], low, high, out[e])
     _outcome(task, e, obs[e], state.x.shape[1])
@@ -316,15 +340,18 @@ def _clip(row, low, high, out):
 
 @njit(cache=True)
 def predicted_apex(task, e, row, n):
-    """Height (m) of the apex the ball is headed for, from env ``e``'s observation ``row``: in
-    flight (no ground contact since the last lift-off) the centre of mass's ballistic apex ``y +
-    v_y^2 / (2 g)``, exact (only gravity acts on the centre); in contact the apex its free energy
-    could reach, ``r + rise`` (the pump's work ``p dA`` on a squashed ball counts)."""
-    if not task.airborne[e]:
-        return task.rest_radius[e] + task.rise[e]
+    """Height (m) of the flight apex the reward measures, from env ``e``'s observation ``row``: while
+    the ball rises in flight, the centre of mass's ballistic apex ``y + v_y^2 / (2 g)`` (exact: only
+    gravity acts on the centre); otherwise (falling, or in contact) the last flight apex reached,
+    capped by the apex its free energy could still reach, ``r + rise``. So energy a bounce loses
+    lowers it at once, and energy put in (a paddle strike, the pump's work ``p dA``) counts from the
+    lift-off it leads to: what the next apex will be, not what the energy would give without the
+    bounce's loss."""
     cy = row[field_start(OBS_CENTRE_OF_MASS_POSITION, n) + 1]
     vy = row[field_start(OBS_CENTRE_OF_MASS_VELOCITY, n) + 1]
-    return cy + 0.5 * vy * vy / task.gravity
+    if task.airborne[e] and vy > 0.0:
+        return cy + 0.5 * vy * vy / task.gravity
+    return min(task.last_apex[e], task.rest_radius[e] + task.rise[e])
 
 
 @njit(cache=True)
@@ -388,6 +415,7 @@ def observe_env(model, state, task, e, row):
     row[field_start(OBS_PRESSURE, n)] = ring_pressure(env_model(model, e), 0, x)
     row[field_start(OBS_PRESSURE_SETPOINT, n)] = task.setpoint[e]
     row[field_start(OBS_TARGET_HEIGHT, n)] = task.target[e]
+    row[field_start(OBS_LAST_APEX, n)] = task.last_apex[e]
     if task.mode == MODE_PADDLE:
         row[field_start(OBS_PADDLE_HEIGHT, n)] = task.paddle_height[e]
         row[field_start(OBS_PADDLE_IN_REACH, n)] = 1.0 if task.in_reach[e] else 0.0
@@ -445,12 +473,14 @@ class BallBatch:
             rest_radius=zeros.copy(),
             paddle_height=zeros.copy(),
             airborne=np.ones(n_envs, dtype=np.bool_),
+            last_apex=zeros.copy(),
             steps=np.zeros(n_envs, dtype=np.int64),
             apex_count=np.zeros(n_envs, dtype=np.int64),
             apex_error=zeros.copy(),
             apex_height=zeros.copy(),
             impulse=zeros.copy(),
             in_reach=np.zeros(n_envs, dtype=np.bool_),
+            struck=np.zeros(n_envs, dtype=np.bool_),
             status=np.zeros(n_envs, dtype=np.int64),
             rise=zeros.copy(),
             reward=np.zeros((n_envs, REWARD.size)),

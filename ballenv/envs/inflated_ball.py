@@ -33,11 +33,12 @@ class InflatedBallEnv(Env, EzPickle):
     start of the control step; the gas law then sets the pressure as the ball deforms, so raising it
     while the ball is squashed does work ``p dA`` as it re-expands.
     Paddle: the paddle hovers at ``target + r`` (where the ball's top is at the target apex); it
-    strikes only when the ball's top is within ``paddle_reach`` of it, and then shares ``J`` equally
+    strikes only when the ball's top is within ``paddle_reach`` of it, at most once per flight (a
+    second strike waits until the ball has touched the ground), and then shares ``J`` equally
     among the nodes within ``paddle_depth`` of the top: the ball's momentum changes by exactly J.
 
     ## Observation Space
-    ``Box(low, high, (5 N + 7,), float32)`` (``+3`` in paddle mode), N nodes (32 for the "fast"
+    ``Box(low, high, (5 N + 8,), float32)`` (``+3`` in paddle mode), N nodes (32 for the "fast"
     preset). Values are clipped to the bounds; ``env.unwrapped.observation_structure`` maps names to
     slices. The layout is declared once, in ``ballenv.envs.observation``; this table repeats it.
 
@@ -51,20 +52,25 @@ class InflatedBallEnv(Env, EzPickle):
     | pressure                 | current gauge pressure of the gas                       | Pa   | [-101325, 1e7] |
     | pressure_setpoint        | the gas amount as gauge pressure at rest (moves toward the command) | Pa | pressure range |
     | target_height            | this episode's target apex height of the centre of mass | m    | target range |
+    | last_apex                | height of the centre at its last flight apex (the start height before the first) | m | [-1, arena] |
     | paddle_height (paddle)   | the paddle's height                                     | m    | [0, arena + 4 r_max] |
-    | paddle_in_reach (paddle) | 1 if the paddle could strike at the last step, else 0   | -    | [0, 1] |
+    | paddle_in_reach (paddle) | 1 if the paddle can strike at the next step, else 0 (one strike per flight) | - | [0, 1] |
     | paddle_impulse (paddle)  | impulse delivered at the last step                      | N s  | [0, J_max] |
 
     ## Rewards
     Every step, in [0, 1] (also ``info["reward_height"]``): how close the apex the ball is headed for
     is to the target, ``exp(-(s e / reward_margin)^2 / 2)`` with ``e = |h - h_target| / h_target``
     and ``s = sqrt(2 ln 10)`` (DeepMind Control's gaussian ``tolerance``: 1 on target, 0.1 at
-    ``e = reward_margin``). ``h`` is, in flight, the centre of mass's ballistic apex ``y + v_y^2 /
-    (2 g)`` (exact: only gravity acts on the centre), and in contact the height its free energy
-    (kinetic, elastic and gas energy above the inflated circle at rest) could lift it to. 0 on a
-    simulator failure. All rewards are >= 0, so ending an episode early forfeits the rest: staying
-    in play pays, and no number of bounces is favoured (the reward counts time, not apexes). The
-    task's measure is the flight apexes' error (``info["apex_height"]``, ``agents.evaluate``).
+    ``e = reward_margin``). ``h`` is, while the ball rises in flight, the centre of mass's ballistic
+    apex ``y + v_y^2 / (2 g)`` (exact: only gravity acts on the centre); otherwise (falling, or in
+    contact) the last flight apex (``last_apex``), capped by the height the free energy (kinetic,
+    elastic and gas energy above the inflated circle at rest) could lift the centre to. Energy a
+    bounce loses lowers ``h`` at once; energy put in by a strike or the pump counts from the lift-off
+    it leads to, so the reward ranks policies as the apex error does (a reward of the energy alone
+    would favour paddle strikes too weak to make up the bounce's loss). 0 on a simulator failure.
+    All rewards are >= 0, so ending an episode early forfeits the rest: staying in play pays, and no
+    number of bounces is favoured (the reward counts time, not apexes). The task's measure is the
+    flight apexes' error (``info["apex_height"]``, ``agents.evaluate``).
 
     ## Starting State
     The ball, inflated to ``initial_pressure``, at rest shape with a random rotation, centre at
@@ -118,8 +124,9 @@ class InflatedBallEnv(Env, EzPickle):
       the apex the ball is headed for (was: apex errors at the apexes, an optional shaping term,
       a penalty per apex missed by ending early; ``apex_reward_weight``, ``shaping_reward_weight``,
       ``termination_reward_weight`` and ``termination_horizon`` replaced by ``reward_margin``).
-      The observation gains ``pressure_setpoint`` (the pump's state; 5 N + 7 entries). The paddle
-      strikes ``max(a, 0) * paddle_max_impulse`` (was ``(a + 1) / 2 * ...``). v0 is no
+      The observation gains ``pressure_setpoint`` (the pump's state) and ``last_apex`` (the
+      reward's memory; 5 N + 8 entries). The paddle
+      strikes ``max(a, 0) * paddle_max_impulse`` (was ``(a + 1) / 2 * ...``), once per flight. v0 is no
       longer registered.
     - v0: initial release.
     """

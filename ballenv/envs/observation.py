@@ -78,6 +78,10 @@ FIELDS = (
         "target_height", 0, 1, lambda c: c.target_height_range[0], lambda c: c.target_height_range[1], "m",
         "this episode's target apex height of the centre of mass",
     ),
+    Field(
+        "last_apex", 0, 1, lambda c: SUNK_HEIGHT, lambda c: c.arena_height, "m",
+        "height of the centre at its last flight apex (the start height before the first)",
+    ),
 )  # fmt: skip
 
 PADDLE_FIELDS = (
@@ -87,7 +91,7 @@ PADDLE_FIELDS = (
     ),
     Field(
         "paddle_in_reach", 0, 1, lambda c: 0.0, lambda c: 1.0, "-",
-        "1 if the paddle could strike at the last step, else 0",
+        "1 if the paddle can strike at the next step, else 0 (one strike per flight)",
     ),
     Field(
         "paddle_impulse", 0, 1, lambda c: 0.0, lambda c: c.paddle_max_impulse, "N s",
@@ -116,6 +120,7 @@ OBS_GROUND_NORMAL_FORCE = _START["ground_normal_force"]
 OBS_PRESSURE = _START["pressure"]
 OBS_PRESSURE_SETPOINT = _START["pressure_setpoint"]
 OBS_TARGET_HEIGHT = _START["target_height"]
+OBS_LAST_APEX = _START["last_apex"]
 OBS_PADDLE_HEIGHT = _START["paddle_height"]
 OBS_PADDLE_IN_REACH = _START["paddle_in_reach"]
 OBS_PADDLE_IMPULSE = _START["paddle_impulse"]

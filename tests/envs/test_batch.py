@@ -8,8 +8,9 @@ import numpy as np
 import pytest
 
 import ballenv  # noqa: F401  (registers the env)
-from ballenv.controllers import PressurePump
+from ballenv.controllers import PaddleDribble, PressurePump
 from ballenv.envs.batch import REWARD_AT_MARGIN, height_reward
+from ballenv.physics.ring import total_mass
 
 MODES = ("pressure", "paddle")
 
@@ -42,21 +43,69 @@ def test_reward_is_in_zero_one_and_is_the_sum_of_its_terms(mode):
     assert rewards.max() > 0.5 and rewards.min() < 0.5  # random actions do reach and miss the target
 
 
-def test_reward_in_flight_is_the_tolerance_of_the_ballistic_apex():
+def _tolerance(height, target, margin):
+    return math.exp(-0.5 * (math.sqrt(2 * math.log(10)) * abs(height - target) / target / margin) ** 2)
+
+
+def test_reward_measures_the_ballistic_apex_rising_and_the_last_apex_falling():
+    """Falling from rest, the reward is that of the start height (the ball's last apex, observed as
+    ``last_apex``); rising after its first bounce, that of its ballistic apex ``y + vy^2 / 2g``;
+    after that flight's apex, that of the apex event the env reported."""
     env = gym.make("InflatedBall-v1")
     obs, info = env.reset(seed=2)
-    structure = env.unwrapped.observation_structure
-    target = info["target_height"]
-    margin = env.unwrapped.config.reward_margin
+    s = env.unwrapped.observation_structure
+    target, margin = info["target_height"], env.unwrapped.config.reward_margin
     g = env.unwrapped.config.gravity
-    for _ in range(5):  # the ball falls from rest: in flight, no contact yet
-        obs, reward, *_ = env.step(np.array([0.0], dtype=np.float32))
-        y = float(obs[structure["centre_of_mass_position"]][1])
-        vy = float(obs[structure["centre_of_mass_velocity"]][1])
-        assert not obs[structure["ground_normal_force"]].any()
-        apex = y + 0.5 * vy * vy / g  # = the drop height while it falls freely
-        expected = math.exp(-0.5 * (math.sqrt(2 * math.log(10)) * abs(apex - target) / target / margin) ** 2)
-        assert reward == pytest.approx(expected, rel=1e-5)  # the observation is float32
+    start = float(obs[s["centre_of_mass_position"]][1])
+    assert obs[s["last_apex"]][0] == pytest.approx(start, rel=1e-6)
+    phases = {"falling": 0, "rising": 0, "after apex": 0}
+    apex = None
+    for _ in range(200):
+        obs, reward, _, _, info = env.step(np.array([0.0], dtype=np.float32))
+        y = float(obs[s["centre_of_mass_position"]][1])
+        vy = float(obs[s["centre_of_mass_velocity"]][1])
+        flying = not obs[s["ground_normal_force"]].any()
+        if info["apex_count"]:
+            apex = info["apex_height"]
+            assert obs[s["last_apex"]][0] == pytest.approx(apex, rel=1e-6)
+        if flying and apex is None and vy < 0.0 and phases["rising"] == 0:
+            phases["falling"] += 1
+            assert reward == pytest.approx(_tolerance(start, target, margin), rel=1e-5)
+        elif flying and vy > 0.0:
+            phases["rising"] += 1
+            assert reward == pytest.approx(_tolerance(y + 0.5 * vy * vy / g, target, margin), rel=1e-4)
+        elif flying and apex is not None:
+            phases["after apex"] += 1
+            assert reward == pytest.approx(_tolerance(apex, target, margin), rel=1e-5)
+            break
+    assert min(phases.values()) > 0, phases
+
+
+def test_reward_favours_the_paddle_strike_that_hits_the_target():
+    """The dribbler's strike sized for the bounce's true loss (retention 0.7 of the energy) hits the
+    target far better than one that ignores the loss (retention 1); the reward ranks them alike."""
+    scores = {}
+    for retention in (0.7, 1.0):
+        env = gym.make("InflatedBallPaddle-v1")
+        config = env.unwrapped.config
+        dribble = PaddleDribble(
+            env.unwrapped.observation_structure, total_mass(config.ring(config.initial_pressure)),
+            retention=retention,
+        )  # fmt: skip
+        total, errors = 0.0, []
+        for seed in range(2):
+            obs, _ = env.reset(seed=100 + seed)
+            dribble.reset()
+            while True:
+                obs, reward, terminated, truncated, info = env.step(dribble.act(obs))
+                total += reward
+                if info["apex_count"]:
+                    errors.append(abs(info["apex_height"] - info["target_height"]) / info["target_height"])
+                if terminated or truncated:
+                    break
+        scores[retention] = (np.mean(errors), total)
+    assert scores[0.7][0] < 0.5 * scores[1.0][0]
+    assert scores[0.7][1] > scores[1.0][1]
 
 
 @pytest.mark.parametrize("seed", [0, 1])

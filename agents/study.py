@@ -1,0 +1,153 @@
+"""Compare trained agents with the baselines the rliable way: several training seeds, held-out
+episodes, interquartile mean (IQM) with bootstrap confidence intervals, learning curves.
+
+    python -m agents.study --algo ppo --action-mode pressure --seeds 0 1 2 --episodes 20
+    python -m agents.study --algo ppo --action-mode paddle --timesteps 400000 --out runs/study
+    python -m agents.study --seeds 0 --episodes 2 --env-kwargs '{"max_episode_steps": 60}' \
+        --timesteps 512 --n-envs 1 --hyperparams '{"n_steps": 64}'     # train.py options pass through
+
+Each seed trains with ``agents.train`` into ``{out}/{algo}_{mode}_seed{k}`` (a folder that already
+holds ``scores.json`` is reused, so an interrupted study resumes); its best model is scored on the
+held-out episodes (seeds 10,000 on), and so are the tuned heuristic and random actions. Writes
+``{out}/{algo}_{mode}.md`` (the table) and ``{out}/{algo}_{mode}.png`` (learning curves, the
+baselines as lines).
+
+Statistics: each episode's apex error (``agents.evaluate``; missed apexes count 1); the IQM is the
+mean of the middle 50 % of the episodes pooled over runs; its 95 % interval comes from a stratified
+two-level bootstrap (draw runs with replacement, then episodes within each drawn run; 2,000
+resamples, percentile interval), so the spread between training seeds counts, as in rliable
+(Agarwal et al., 2021, "Deep RL at the edge of the statistical precipice"). rliable itself is not
+used: its pin ``arch < 8`` does not import beside pandas 3.
+"""
+
+import argparse
+import json
+import pathlib
+
+import numpy as np
+
+from .evaluate import Score, evaluate, parse_env_kwargs
+
+RESAMPLES = 2000
+
+
+def iqm(values):
+    """Interquartile mean: the mean of the values between the 25th and 75th percentiles (the
+    middle half, by rank; rliable's ``aggregate_iqm``, scipy's ``trim_mean(values, 0.25)``)."""
+    v = np.sort(np.asarray(values, dtype=float).ravel())
+    cut = int(np.floor(0.25 * v.size))
+    return float(v[cut : v.size - cut].mean())
+
+
+def bootstrap_iqm(runs, seed=0, resamples=RESAMPLES):
+    """95 % percentile interval of the IQM of ``runs`` (a list of per-run arrays of episode scores):
+    each resample draws runs with replacement, then episodes with replacement within each."""
+    rng = np.random.default_rng(seed)
+    runs = [np.asarray(r, dtype=float) for r in runs]
+    stats = np.empty(resamples)
+    for k in range(resamples):
+        picked = rng.integers(len(runs), size=len(runs))
+        stats[k] = iqm(np.concatenate([rng.choice(runs[i], size=runs[i].size) for i in picked]))
+    low, high = np.percentile(stats, [2.5, 97.5])
+    return float(low), float(high)
+
+
+def summarise(name, scores):
+    """One table row (a dict) of ``scores``, one :class:`Score` per run."""
+    runs = [s.episode_apex_errors for s in scores]
+    low, high = bootstrap_iqm(runs)
+    return {
+        "policy": name, "runs": len(scores), "episodes": sum(len(r) for r in runs),
+        "iqm": iqm(np.concatenate(runs)), "ci": (low, high),
+        "mean": float(np.mean(np.concatenate(runs))),
+        "success": float(np.mean([s.success_rate for s in scores])),
+        "return": float(np.mean([s.episode_return for s in scores])),
+    }  # fmt: skip
+
+
+def table(rows):
+    lines = [
+        "| policy | runs x episodes | apex error IQM [95 % CI] | apex error mean | apexes within 5 % "
+        "| return |",
+        "|---|---:|---:|---:|---:|---:|",
+    ]
+    for r in rows:
+        lines.append(
+            f"| {r['policy']} | {r['runs']} x {r['episodes'] // r['runs']} | {r['iqm']:.3f} "
+            f"[{r['ci'][0]:.3f}, {r['ci'][1]:.3f}] | {r['mean']:.3f} | {100 * r['success']:.1f} % | "
+            f"{r['return']:.0f} |"
+        )
+    return "\n".join(lines)
+
+
+def train_seed(args, seed):
+    """The run folder of ``seed``, trained now unless it holds scores already."""
+    from .train import parse_args, train
+
+    run = args.out / f"{args.algo}_{args.action_mode}_seed{seed}"
+    if (run / "scores.json").exists():
+        return run
+    argv = [
+        "--algo", args.algo, "--action-mode", args.action_mode, "--vec-env", "subproc", "--seed", str(seed),
+        "--log-dir", str(args.out), "--no-baselines", "--final-episodes", str(args.episodes),
+    ] + (["--total-timesteps", str(args.timesteps)] if args.timesteps else []) + args.train_args  # fmt: skip
+    return train(parse_args(argv))
+
+
+def plot(path, runs, baselines, title):
+    """Mean periodic-evaluation return over seeds (band: lowest to highest seed) against env steps,
+    the baselines' held-out returns as lines."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    curves = [np.load(r / "evaluations.npz") for r in runs]
+    steps = curves[0]["timesteps"]
+    n = min(len(c["timesteps"]) for c in curves)
+    returns = np.array([c["results"][:n].mean(axis=1) for c in curves])
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ax.plot(steps[:n], returns.mean(axis=0), "o-", label=f"trained, mean of {len(runs)} seeds")
+    ax.fill_between(steps[:n], returns.min(axis=0), returns.max(axis=0), alpha=0.2)
+    for row, color in zip(baselines, ("tab:green", "tab:red"), strict=False):
+        ax.axhline(row["return"], color=color, ls="--", label=f"{row['policy']} (held-out)")
+    ax.set_xlabel("env steps")
+    ax.set_ylabel("episode return (periodic evaluation)")
+    ax.set_title(title)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(prog="python -m agents.study", description=__doc__.split("\n")[0])
+    p.add_argument("--algo", choices=("ppo", "sac"), default="ppo")
+    p.add_argument("--action-mode", choices=("pressure", "paddle"), default="pressure")
+    p.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2], help="training seeds")
+    p.add_argument("--timesteps", type=int, default=None, help="env steps per run (default: the YAML)")
+    p.add_argument("--episodes", type=int, default=20, help="held-out episodes per policy and run")
+    p.add_argument("--out", type=pathlib.Path, default=pathlib.Path("runs/study"))
+    p.add_argument("--env-kwargs", type=parse_env_kwargs, default={}, help="JSON object of env keywords")
+    args, args.train_args = p.parse_known_args(argv)  # the rest goes to agents.train
+    if args.env_kwargs:
+        args.train_args += ["--env-kwargs", json.dumps(args.env_kwargs)]
+    runs = [train_seed(args, seed) for seed in args.seeds]
+    trained = [Score(**json.loads((r / "scores.json").read_text())[0]) for r in runs]
+    mode = {**args.env_kwargs, "action_mode": args.action_mode}
+    baselines = [
+        summarise(name, [evaluate(name, mode, args.episodes, progress=True)])
+        for name in ("heuristic", "random")
+    ]
+    rows = [summarise(f"{args.algo} (best model)", trained), *baselines]
+    name = args.out / f"{args.algo}_{args.action_mode}"
+    text = table(rows)
+    name.with_suffix(".md").write_text(text + "\n")
+    name.with_suffix(".json").write_text(json.dumps(rows, indent=2))
+    plot(name.with_suffix(".png"), runs, baselines, f"{args.algo}, {args.action_mode} mode")
+    print(text)
+    print(f"wrote {name}.md, {name}.json and {name}.png")
+
+
+if __name__ == "__main__":
+    main()

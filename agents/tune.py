@@ -1,0 +1,187 @@
+"""Tune with Optuna: the scripted controllers' parameters, or PPO's hyperparameters.
+
+    python -m agents.tune heuristic --action-mode pressure --trials 60
+    python -m agents.tune ppo --action-mode paddle --trials 12 --timesteps 100000 [train.py options]
+
+Both search with Optuna's TPE sampler (seeded: the same command gives the same trials) on training
+seeds; the held-out seeds of ``agents.evaluate`` (10,000 on) stay unseen.
+
+* ``heuristic``: the controller's parameters (:data:`HEURISTIC_SPACE`); objective the mean apex
+  error over ``--episodes`` episodes seeded 0, 1, ... The best is written to
+  ``agents/hyperparams/heuristic.yml`` under the env id, where ``agents.baselines.HeuristicPolicy``
+  reads it (``--dry-run``: print it only).
+* ``ppo``: the hyperparameters of :func:`sample_ppo` (the ranges of RL Baselines3 Zoo's PPO
+  sampler, narrowed to this budget); each trial trains ``--timesteps`` env steps with
+  ``agents.train``, its periodic evaluations (mean return over 5 episodes) feed Optuna's median
+  pruner, and the objective is the last one. The trials' table and the best entry (RL Zoo format)
+  are written to ``{out}/ppo_{mode}.md`` and ``{out}/ppo_{mode}.yml``.
+"""
+
+import argparse
+import json
+import pathlib
+
+import numpy as np
+import yaml
+
+from .baselines import HEURISTIC_PARAMS, HeuristicPolicy
+from .evaluate import evaluate
+
+# name -> (low, high, log scale) of each controller parameter
+HEURISTIC_SPACE = {
+    "pressure": {
+        "landing_height": (0.15, 0.6, False),  # m: pump from this height on the way down
+        "gain": (0.5, 16.0, True),  # amplitude per relative apex error
+        "bias": (0.0, 1.0, False),  # amplitude on target
+        "floor": (-1.0, 0.5, False),  # smallest amplitude
+    },
+    "paddle": {"retention": (0.5, 0.95, False)},  # fraction of a bounce's energy kept
+}
+
+
+def heuristic_objective(mode, episodes):
+    """Optuna objective: mean apex error of the controller with a trial's parameters."""
+
+    def objective(trial):
+        params = {
+            name: trial.suggest_float(name, low, high, log=log)
+            for name, (low, high, log) in HEURISTIC_SPACE[mode].items()
+        }
+        score = evaluate(
+            lambda env: HeuristicPolicy(env, params), {"action_mode": mode}, episodes, seed=0
+        )  # fmt: skip
+        trial.set_user_attr("success_rate", score.success_rate)
+        return score.apex_error
+
+    return objective
+
+
+def tune_heuristic(args):
+    import optuna
+
+    study = optuna.create_study(direction="minimize", sampler=optuna.samplers.TPESampler(seed=args.seed))
+    study.optimize(heuristic_objective(args.action_mode, args.episodes), n_trials=args.trials)
+    best = {k: round(float(v), 4) for k, v in study.best_params.items()}
+    print(f"best apex error {study.best_value:.4f} over {args.episodes} training episodes: {best}")
+    if not args.dry_run:
+        from ballenv.envs import ENV_IDS
+
+        table = yaml.safe_load(HEURISTIC_PARAMS.read_text()) or {} if HEURISTIC_PARAMS.exists() else {}
+        table[ENV_IDS[args.action_mode]] = best
+        header = (
+            "# The scripted controllers' parameters, tuned by `python -m agents.tune heuristic` (Optuna\n"
+            "# TPE, mean apex error over training seeds), one entry per env id; read by\n"
+            "# agents.baselines.HeuristicPolicy.\n"
+        )
+        HEURISTIC_PARAMS.write_text(header + yaml.safe_dump(table, sort_keys=True))
+        print(f"wrote {HEURISTIC_PARAMS}")
+    return study
+
+
+def sample_ppo(trial):
+    """PPO hyperparameters of one trial (RL Zoo's sampler, narrowed)."""
+    n_steps = trial.suggest_categorical("n_steps", [256, 512, 1024])
+    return {
+        "n_steps": n_steps,
+        "batch_size": trial.suggest_categorical("batch_size", [64, 128, 256]),
+        "gamma": trial.suggest_categorical("gamma", [0.98, 0.99, 0.995, 0.998]),
+        "gae_lambda": trial.suggest_categorical("gae_lambda", [0.9, 0.95, 0.98, 0.99]),
+        "learning_rate": trial.suggest_float("learning_rate", 5e-5, 2e-3, log=True),
+        "n_epochs": trial.suggest_categorical("n_epochs", [5, 10, 20]),
+        "clip_range": trial.suggest_categorical("clip_range", [0.1, 0.2, 0.3]),
+        "ent_coef": trial.suggest_float("ent_coef", 1e-8, 1e-2, log=True),
+        "sde_sample_freq": trial.suggest_categorical("sde_sample_freq", [4, 8, 16, 32]),
+        "policy_kwargs": {
+            "net_arch": [trial.suggest_categorical("width", [64, 128, 256])] * 2,
+            "log_std_init": trial.suggest_float("log_std_init", -2.0, 0.0),
+        },
+    }
+
+
+def ppo_objective(args):
+    """Optuna objective: train one PPO trial, pruned on its periodic evaluations."""
+    import optuna
+
+    from .train import parse_args, train
+
+    def objective(trial):
+        hp = sample_ppo(trial)
+        argv = [
+            "--algo", "ppo", "--action-mode", args.action_mode, "--vec-env", "subproc",
+            "--total-timesteps", str(args.timesteps), "--eval-freq", str(args.timesteps // 5),
+            "--seed", str(args.seed + trial.number), "--log-dir", str(args.out / f"ppo_{args.action_mode}"),
+            "--no-baselines", "--final-episodes", "0", "--hyperparams", json.dumps(hp),
+        ] + args.train_args  # fmt: skip
+        run = train(parse_args(argv), on_evaluation=_reporter(trial))
+        returns = np.load(run / "evaluations.npz")["results"].mean(axis=1)
+        trial.set_user_attr("run", str(run))
+        if trial.should_prune():
+            raise optuna.TrialPruned()
+        return float(returns[-1])
+
+    return objective
+
+
+def _reporter(trial):
+    def report(step, mean_return):
+        trial.report(mean_return, step)
+        return not trial.should_prune()  # False stops the training
+
+    return report
+
+
+def tune_ppo(args):
+    import optuna
+
+    from ballenv.envs import ENV_IDS
+
+    args.out.mkdir(parents=True, exist_ok=True)
+    study = optuna.create_study(
+        direction="maximize", sampler=optuna.samplers.TPESampler(seed=args.seed, n_startup_trials=4),
+        pruner=optuna.pruners.MedianPruner(n_startup_trials=3, n_warmup_steps=args.timesteps // 3),
+    )  # fmt: skip
+    study.enqueue_trial(_current_ppo(args.action_mode))  # the present file's values first
+    study.optimize(ppo_objective(args), n_trials=args.trials)
+    lines = ["| trial | state | last evaluation return | hyperparameters |", "|---:|---|---:|---|"]
+    for t in study.trials:
+        value = "" if t.value is None else f"{t.value:.1f}"
+        lines.append(f"| {t.number} | {t.state.name.lower()} | {value} | {t.params} |")
+    name = args.out / f"ppo_{args.action_mode}"
+    name.with_suffix(".md").write_text("\n".join(lines) + "\n")
+    best = {ENV_IDS[args.action_mode]: sample_ppo(optuna.trial.FixedTrial(study.best_params))}
+    name.with_suffix(".yml").write_text(yaml.safe_dump(best, sort_keys=False))
+    print("\n".join(lines))
+    print(f"best return {study.best_value:.1f}; wrote {name}.md and {name}.yml")
+    return study
+
+
+def _current_ppo(mode):
+    """The PPO file's values for ``mode`` as trial parameters (the first trial)."""
+    from .train import load_hyperparams
+
+    hp = load_hyperparams("ppo", mode)
+    keys = ("n_steps", "batch_size", "gamma", "gae_lambda", "learning_rate", "n_epochs", "clip_range")
+    params = {k: hp[k] for k in keys}
+    params["ent_coef"] = max(float(hp.get("ent_coef", 0.0)), 1e-8)
+    params["sde_sample_freq"] = hp.get("sde_sample_freq", 8)
+    params["width"] = hp["policy_kwargs"]["net_arch"][0]
+    params["log_std_init"] = hp["policy_kwargs"].get("log_std_init", 0.0)
+    return params
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(prog="python -m agents.tune", description=__doc__.split("\n")[0])
+    p.add_argument("what", choices=("heuristic", "ppo"), help="what to tune")
+    p.add_argument("--action-mode", choices=("pressure", "paddle"), default="pressure")
+    p.add_argument("--trials", type=int, default=40, help="Optuna trials")
+    p.add_argument("--episodes", type=int, default=20, help="heuristic: training episodes per trial")
+    p.add_argument("--timesteps", type=int, default=100_000, help="ppo: env steps per trial")
+    p.add_argument("--seed", type=int, default=0, help="sampler seed (ppo: trial k trains with seed + k)")
+    p.add_argument("--out", type=pathlib.Path, default=pathlib.Path("runs/tune"), help="ppo: output folder")
+    p.add_argument("--dry-run", action="store_true", help="heuristic: print the best, do not write it")
+    args, args.train_args = p.parse_known_args(argv)  # ppo: the rest goes to agents.train
+    (tune_heuristic if args.what == "heuristic" else tune_ppo)(args)
+
+
+if __name__ == "__main__":
+    main()

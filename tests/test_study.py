@@ -1,0 +1,50 @@
+"""agents.study: the interquartile mean, its two-level bootstrap interval, and a tiny study end to end."""
+
+import json
+
+import numpy as np
+import pytest
+
+from agents.study import bootstrap_iqm, iqm, main
+
+SHORT = {"max_episode_steps": 60}
+
+
+def test_iqm_is_the_mean_of_the_middle_half():
+    assert iqm([1, 2, 3, 4, 5, 6, 7, 8]) == 4.5  # mean of 3, 4, 5, 6
+    assert iqm([100.0, 1.0, 2.0, -100.0]) == 1.5  # the outliers drop out
+    values = np.random.default_rng(0).normal(size=400)
+    middle = np.sort(values)[100:300]
+    assert iqm(values) == pytest.approx(middle.mean(), rel=1e-12)
+
+
+def test_the_interval_counts_the_spread_between_runs():
+    """Two runs whose episodes all score 0 and all score 1: a quarter of the resamples draw run 0
+    twice (IQM 0) and a quarter run 1 twice (IQM 1), so the 95 % interval is [0, 1]; resampling
+    episodes alone would give a point."""
+    runs = [np.zeros(10), np.ones(10)]
+    assert bootstrap_iqm(runs) == (0.0, 1.0)
+    assert bootstrap_iqm([np.full(10, 0.3)]) == pytest.approx((0.3, 0.3))
+    low, high = bootstrap_iqm([np.linspace(0.0, 1.0, 20)] * 3)
+    assert low < 0.5 < high and 0.0 <= low and high <= 1.0
+
+
+def test_a_tiny_study_runs_end_to_end(tmp_path, capsys):
+    argv = [
+        "--seeds", "0", "1", "--episodes", "2", "--out", str(tmp_path), "--env-kwargs", json.dumps(SHORT),
+        "--timesteps", "128", "--n-envs", "1", "--eval-freq", "64", "--eval-episodes", "1",
+        "--hyperparams", json.dumps({"n_steps": 64, "batch_size": 64, "n_epochs": 1}),
+    ]  # fmt: skip
+    main(argv)
+    rows = json.loads((tmp_path / "ppo_pressure.json").read_text())
+    assert [r["policy"] for r in rows] == ["ppo (best model)", "heuristic", "random"]
+    assert rows[0]["runs"] == 2 and rows[0]["episodes"] == 4 and rows[1]["episodes"] == 2
+    for r in rows:
+        assert r["ci"][0] <= r["iqm"] <= r["ci"][1]
+    assert (tmp_path / "ppo_pressure.png").stat().st_size > 0
+    assert "apex error IQM" in (tmp_path / "ppo_pressure.md").read_text()
+    assert "apex error IQM" in capsys.readouterr().out
+    mtime = (tmp_path / "ppo_pressure_seed0" / "scores.json").stat().st_mtime
+    main(argv)  # resumes: the trained seeds are reused, not trained again
+    assert (tmp_path / "ppo_pressure_seed0" / "scores.json").stat().st_mtime == mtime
+    assert not (tmp_path / "ppo_pressure_seed0_2").exists()
