@@ -73,8 +73,9 @@ def tuned_heuristic(mode):
 class ModelPolicy:
     """A saved Stable-Baselines3 model (``model.zip`` of a run folder, or any path to a .zip).
 
-    The observation normalisation the model was trained with (``vecnormalize.pkl`` next to it,
-    ``best_vecnormalize.pkl`` for ``best_model.zip``) is applied frozen, if present.
+    The observation wrapper the run was trained behind (``env_wrapper`` in its ``config.yml``) and
+    the observation normalisation (``vecnormalize.pkl`` next to it, ``best_vecnormalize.pkl`` for
+    ``best_model.zip``) are applied, the latter frozen, if present.
     """
 
     name = "trained"
@@ -90,6 +91,7 @@ class ModelPolicy:
         if not path.exists():
             raise ValueError(f"agents.evaluate: policy file {str(path)!r} does not exist")
         algo = algo or _algo_of(path)
+        self.wrapper = _run_wrapper(path, env)
         cls = {"ppo": PPO, "sac": SAC}[algo]
         self.model = cls.load(path, device="cpu")
         self.normalize = None  # the saved VecNormalize (its env detached), frozen
@@ -107,10 +109,25 @@ class ModelPolicy:
         pass
 
     def act(self, obs):
+        if self.wrapper is not None:
+            obs = self.wrapper.observation(obs)
         if self.normalize is not None:
             obs = self.normalize.normalize_obs(obs).astype(np.float32)
         action, _ = self.model.predict(obs, deterministic=True)
         return np.asarray(action, dtype=np.float32).reshape(1)
+
+
+def _run_wrapper(path, env):
+    """The observation wrapper of the run folder holding ``path`` around ``env`` (else None)."""
+    config = path.parent / "config.yml"
+    if not config.exists():
+        return None
+    import yaml
+
+    from .wrappers import wrapper_class
+
+    cls = wrapper_class(yaml.safe_load(config.read_text()).get("env_wrapper"))
+    return None if cls is None else cls(env)
 
 
 def _algo_of(path):

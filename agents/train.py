@@ -31,7 +31,7 @@ import numpy as np
 import yaml
 
 HYPERPARAMS = pathlib.Path(__file__).parent / "hyperparams"
-RUN_KEYS = ("n_timesteps", "n_envs", "policy", "normalize", "env_kwargs")
+RUN_KEYS = ("n_timesteps", "n_envs", "policy", "normalize", "env_kwargs", "env_wrapper")
 
 
 def parse_args(argv=None):
@@ -89,14 +89,19 @@ def run_folder(log_dir, algo, mode, seed):
     return path
 
 
-def make_envs(env_kwargs, n_envs, seed, normalize, gamma, monitor_dir=None, training=True, subproc=False):
+def make_envs(
+    env_kwargs, n_envs, seed, normalize, gamma, monitor_dir=None, training=True, subproc=False, wrapper=None
+):  # fmt: skip
     import gymnasium as gym
     from stable_baselines3.common.env_util import make_vec_env
     from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecNormalize
 
+    from .wrappers import wrapper_class
+
     compile_once(gym, env_kwargs)
     envs = make_vec_env(
         env_id(env_kwargs["action_mode"]), n_envs=n_envs, seed=seed, env_kwargs=env_kwargs,
+        wrapper_class=wrapper_class(wrapper),
         vec_env_cls=SubprocVecEnv if subproc and n_envs > 1 else DummyVecEnv,
         monitor_dir=None if monitor_dir is None else str(monitor_dir),
     )  # fmt: skip
@@ -209,6 +214,7 @@ def train(args, on_evaluation=None):
     n_envs = args.n_envs or int(hp.get("n_envs", 1))
     total = args.total_timesteps or int(hp["n_timesteps"])
     normalize = bool(hp.get("normalize", True))
+    wrapper = hp.get("env_wrapper")
     algo_kwargs = {k: v for k, v in hp.items() if k not in RUN_KEYS}
     cls = {"ppo": PPO, "sac": SAC}[args.algo]
     check_hyperparams(cls, algo_kwargs)
@@ -218,7 +224,7 @@ def train(args, on_evaluation=None):
     config = {
         "algo": args.algo, "env_id": env_id(args.action_mode), "env_kwargs": env_kwargs, "seed": args.seed,
         "total_timesteps": total, "n_envs": n_envs, "normalize": normalize,
-        "policy": hp.get("policy", "MlpPolicy"),
+        "policy": hp.get("policy", "MlpPolicy"), "env_wrapper": wrapper,
         "hyperparams": algo_kwargs, "eval_freq": args.eval_freq, "eval_episodes": args.eval_episodes,
         "vec_env": args.vec_env,
         "versions": {"stable_baselines3": str(stable_baselines3.__version__),
@@ -229,9 +235,10 @@ def train(args, on_evaluation=None):
     torch.set_num_threads(1)
 
     envs = make_envs(
-        env_kwargs, n_envs, args.seed, normalize, gamma, run / "monitor", subproc=args.vec_env == "subproc"
-    )
-    eval_env = make_envs(env_kwargs, 1, args.seed + 1000, normalize, gamma, training=False)
+        env_kwargs, n_envs, args.seed, normalize, gamma, run / "monitor", subproc=args.vec_env == "subproc",
+        wrapper=wrapper,
+    )  # fmt: skip
+    eval_env = make_envs(env_kwargs, 1, args.seed + 1000, normalize, gamma, training=False, wrapper=wrapper)
     model = cls(
         config["policy"], envs, seed=args.seed, tensorboard_log=str(run / "tensorboard"), device="cpu",
         verbose=0, **algo_kwargs,

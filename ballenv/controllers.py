@@ -87,4 +87,4 @@ class PaddleDribble(_Controller):
             return idle
         speed = -vy
         impulse = m * (-speed + np.sqrt(speed * speed + 2.0 * needed / m))
-        return np.array([min(1.0, impulse / self.max_impulse)], dtype=np.float32)
+        return np.array([min(1.0, 2.0 * impulse / self.max_impulse - 1.0)], dtype=np.float32)

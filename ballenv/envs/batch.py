@@ -98,7 +98,7 @@ class Task(NamedTuple):
     pressure_low: float  # Pa, gauge pressure at rest for action -1
     pressure_high: float  # Pa, for action +1
     pressure_rate: float  # Pa/s: the gas setpoint moves toward the command at most this fast
-    paddle_max_impulse: float  # N s, for action +1 (actions <= 0: no strike)
+    paddle_max_impulse: float  # N s, for action +1 (-1: no strike)
     paddle_reach: float  # m: the paddle strikes when the ball's top is within this of its height
     paddle_depth: float  # m: it touches the nodes within this of the ball's top
     ground_height: float  # m
@@ -197,7 +197,7 @@ def reset_env(
     task.apex_height[e] = 0.0
     task.impulse[e] = 0.0
     task.struck[e] = False
-    task.in_reach[e] = _paddle_ready(task, e, x)
+    task.in_reach[e] = _paddle_ready(task, e, x, v)
     task.status[e] = STATUS_DONE
     task.rise[e] = _rise(me, se, task, e)
     task.reward[e, :] = 0.0
@@ -226,13 +226,17 @@ def _top(x):
 
 
 @njit(cache=True)
-def _paddle_ready(task, e, x):
-    """Whether the paddle can strike env ``e``'s ball at positions ``x``: paddle mode, the ball's top
-    within ``paddle_reach`` of the paddle, and no strike yet since the ball last touched the ground
-    (one strike per flight, as a hand dribbles)."""
+def _paddle_ready(task, e, x, v):
+    """Whether the paddle can strike env ``e``'s ball (positions ``x``, velocities ``v``): paddle
+    mode, the ball falling (its centre of mass moving down) with its top within ``paddle_reach`` of
+    the paddle, and no strike yet since the ball last touched the ground (one strike per flight, as
+    a hand dribbles: it meets the ball coming down)."""
     if task.mode != MODE_PADDLE or task.struck[e]:
         return False
-    return abs(_top(x) - task.paddle_height[e]) <= task.paddle_reach
+    falling = 0.0
+    for i in range(v.shape[0]):
+        falling += v[i, 1]
+    return falling < 0.0 and abs(_top(x) - task.paddle_height[e]) <= task.paddle_reach
 
 
 @njit(cache=True)
@@ -249,7 +253,7 @@ def _actuate(me, se, task, e, action, ws, nodes):
             task.setpoint[e] = pressure
             task.rest_radius[e] = rest_circle_radius(me, 0, pressure, n)
         return
-    impulse = max(action, 0.0) * task.paddle_max_impulse
+    impulse = 0.5 * (action + 1.0) * task.paddle_max_impulse
     if not task.in_reach[e] or impulse <= 0.0:
         return
     top = _top(x)
@@ -310,7 +314,7 @@ def step_env(
     task.status[e] = status
     task.steps[e] += 1
     task.rise[e] = _rise(me, se, task, e)
-    task.in_reach[e] = _paddle_ready(task, e, se.x[0])
+    task.in_reach[e] = _paddle_ready(task, e, se.x[0], se.v[0])
     observe_env(model, state, task, e, obs[e])
     _clip(obs[e], low, high, out[e])
     _outcome(task, e, obs[e], state.x.shape[1])

@@ -26,16 +26,18 @@ class InflatedBallEnv(Env, EzPickle):
     | Mode     | Action a in [-1, 1] sets                                                     | Unit  |
     |----------|------------------------------------------------------------------------------|-------|
     | pressure | the gas amount, as the gauge pressure at rest p = p_lo + (a + 1)/2 (p_hi - p_lo) | Pa |
-    | paddle   | the downward impulse J = max(a, 0) * paddle_max_impulse, delivered if in reach | N s |
+    | paddle   | the downward impulse J = (a + 1)/2 * paddle_max_impulse of the next strike    | N s |
 
     Pressure: the gas setpoint moves toward the commanded value at most ``pressure_rate`` (a pump's
     flow; instant jumps of the gas ring the ball's breathing mode like a bell) and is applied at the
     start of the control step; the gas law then sets the pressure as the ball deforms, so raising it
     while the ball is squashed does work ``p dA`` as it re-expands.
     Paddle: the paddle hovers at ``target + r`` (where the ball's top is at the target apex); it
-    strikes only when the ball's top is within ``paddle_reach`` of it, at most once per flight (a
-    second strike waits until the ball has touched the ground), and then shares ``J`` equally
-    among the nodes within ``paddle_depth`` of the top: the ball's momentum changes by exactly J.
+    strikes only a falling ball (centre of mass moving down) whose top is within ``paddle_reach``
+    of it, at most once per flight (a second strike waits until the ball has touched the ground),
+    as a dribbling hand meets the ball coming down, and then shares ``J`` equally among the nodes
+    within ``paddle_depth`` of the top: the ball's momentum changes by exactly J. Action -1 lets the
+    ball pass unstruck (it may still be struck later in the same flight).
 
     ## Observation Space
     ``Box(low, high, (5 N + 8,), float32)`` (``+3`` in paddle mode), N nodes (32 for the "fast"
@@ -54,7 +56,7 @@ class InflatedBallEnv(Env, EzPickle):
     | target_height            | this episode's target apex height of the centre of mass | m    | target range |
     | last_apex                | height of the centre at its last flight apex (the start height before the first) | m | [-1, arena] |
     | paddle_height (paddle)   | the paddle's height                                     | m    | [0, arena + 4 r_max] |
-    | paddle_in_reach (paddle) | 1 if the paddle can strike at the next step, else 0 (one strike per flight) | - | [0, 1] |
+    | paddle_in_reach (paddle) | 1 if the paddle can strike at the next step, else 0 (a falling ball, once per flight) | - | [0, 1] |
     | paddle_impulse (paddle)  | impulse delivered at the last step                      | N s  | [0, J_max] |
 
     ## Rewards
@@ -125,9 +127,8 @@ class InflatedBallEnv(Env, EzPickle):
       a penalty per apex missed by ending early; ``apex_reward_weight``, ``shaping_reward_weight``,
       ``termination_reward_weight`` and ``termination_horizon`` replaced by ``reward_margin``).
       The observation gains ``pressure_setpoint`` (the pump's state) and ``last_apex`` (the
-      reward's memory; 5 N + 8 entries). The paddle
-      strikes ``max(a, 0) * paddle_max_impulse`` (was ``(a + 1) / 2 * ...``), once per flight. v0 is no
-      longer registered.
+      reward's memory; 5 N + 8 entries). The paddle strikes only a falling ball, once per flight
+      (was: at every step the ball's top was in reach). v0 is no longer registered.
     - v0: initial release.
     """
 

@@ -91,7 +91,7 @@ PADDLE_FIELDS = (
     ),
     Field(
         "paddle_in_reach", 0, 1, lambda c: 0.0, lambda c: 1.0, "-",
-        "1 if the paddle can strike at the next step, else 0 (one strike per flight)",
+        "1 if the paddle can strike at the next step, else 0 (a falling ball, once per flight)",
     ),
     Field(
         "paddle_impulse", 0, 1, lambda c: 0.0, lambda c: c.paddle_max_impulse, "N s",

@@ -83,7 +83,8 @@ def _expected(env, info):
         out["paddle_height"] = [info["target_height"] + batch.task.rest_radius[0]]
         config = env.unwrapped.config
         reach = abs(x[:, 1].max() - out["paddle_height"][0]) <= config.paddle_reach
-        out["paddle_in_reach"] = [float(reach and not batch.task.struck[0])]
+        falling = v[:, 1].mean() < 0.0
+        out["paddle_in_reach"] = [float(reach and falling and not batch.task.struck[0])]
         out["paddle_impulse"] = [info.get("paddle_impulse", 0.0)]
     return out
 

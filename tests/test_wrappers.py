@@ -1,0 +1,66 @@
+"""agents.wrappers: the ball-state observation, and a run trained behind it evaluates behind it."""
+
+import json
+import pathlib
+import subprocess
+import sys
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import ballenv  # noqa: F401  (registers the env)
+from agents.evaluate import evaluate
+from agents.wrappers import BallStateObservation, wrapper_class
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+
+
+@pytest.mark.parametrize("mode", ["pressure", "paddle"])
+def test_ball_state_keeps_the_body_fields_and_the_total_ground_force(mode):
+    raw = gym.make("InflatedBall-v1", action_mode=mode)
+    env = BallStateObservation(gym.make("InflatedBall-v1", action_mode=mode))
+    s = raw.unwrapped.observation_structure
+    assert env.observation_space.shape == ((9,) if mode == "pressure" else (12,))
+    obs, _ = env.reset(seed=5)
+    full, _ = raw.reset(seed=5)
+    for _ in range(60):  # into the first contact
+        action = np.array([0.3], dtype=np.float32)
+        obs, *_ = env.step(action)
+        full, *_ = raw.step(action)
+    assert env.observation_space.contains(obs)
+    assert obs[0:2] == pytest.approx(full[s["centre_of_mass_position"]])
+    assert obs[2:4] == pytest.approx(full[s["centre_of_mass_velocity"]])
+    assert obs[6] == full[s["target_height"]][0] and obs[7] == full[s["last_apex"]][0]
+    assert obs[-1] == pytest.approx(full[s["ground_normal_force"]].sum(), rel=1e-5)
+    if mode == "paddle":
+        assert obs[8:11] == pytest.approx(np.concatenate([full[s[k]] for k in ("paddle_height",
+                                          "paddle_in_reach", "paddle_impulse")]))  # fmt: skip
+
+
+def test_a_wrapper_name_that_does_not_import_is_one_readable_error():
+    assert wrapper_class(None) is None
+    assert wrapper_class("agents.wrappers.BallStateObservation") is BallStateObservation
+    with pytest.raises(ValueError, match="env_wrapper = 'agents.wrappers.Nope'"):
+        wrapper_class("agents.wrappers.Nope")
+
+
+def test_a_run_trained_behind_the_wrapper_is_evaluated_behind_it(tmp_path):
+    hp = {
+        "n_steps": 64,
+        "batch_size": 64,
+        "n_epochs": 1,
+        "env_wrapper": "agents.wrappers.BallStateObservation",
+    }
+    command = [
+        sys.executable, str(ROOT / "train.py"), "--n-envs", "1", "--total-timesteps", "128",
+        "--eval-freq", "64", "--eval-episodes", "1", "--final-episodes", "1", "--no-baselines",
+        "--log-dir", str(tmp_path), "--env-kwargs", json.dumps({"max_episode_steps": 60}),
+        "--hyperparams", json.dumps(hp),
+    ]  # fmt: skip
+    done = subprocess.run(command, cwd=ROOT, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr[-3000:]
+    run = tmp_path / "ppo_pressure_seed0"
+    scores = json.loads((run / "scores.json").read_text())
+    again = evaluate(str(run), {"max_episode_steps": 60}, episodes=1)
+    assert again.episode_apex_errors == pytest.approx(scores[0]["episode_apex_errors"])
