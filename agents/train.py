@@ -206,6 +206,8 @@ def train(args, on_evaluation=None):
     import torch
     from stable_baselines3 import PPO, SAC
 
+    from .wrappers import wrapper_class
+
     hp = load_hyperparams(args.algo, args.action_mode)
     hp.update(args.hyperparams or {})
     env_kwargs = dict(hp.get("env_kwargs") or {})
@@ -218,6 +220,10 @@ def train(args, on_evaluation=None):
     algo_kwargs = {k: v for k, v in hp.items() if k not in RUN_KEYS}
     cls = {"ppo": PPO, "sac": SAC}[args.algo]
     check_hyperparams(cls, algo_kwargs)
+    try:
+        wrapper_class(wrapper)
+    except ValueError as err:
+        raise UsageError(str(err)) from None
     gamma = float(algo_kwargs.get("gamma", 0.99))
 
     run = run_folder(args.log_dir, args.algo, args.action_mode, args.seed)

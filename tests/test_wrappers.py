@@ -64,3 +64,13 @@ def test_a_run_trained_behind_the_wrapper_is_evaluated_behind_it(tmp_path):
     scores = json.loads((run / "scores.json").read_text())
     again = evaluate(str(run), {"max_episode_steps": 60}, episodes=1)
     assert again.episode_apex_errors == pytest.approx(scores[0]["episode_apex_errors"])
+
+
+def test_a_mistyped_wrapper_stops_train_before_any_run_folder(tmp_path):
+    from agents.train import main as train_main
+
+    with pytest.raises(SystemExit, match="env_wrapper = 'agents.wrappers.Nope'"):
+        train_main(
+            ["--log-dir", str(tmp_path), "--hyperparams", json.dumps({"env_wrapper": "agents.wrappers.Nope"})]
+        )
+    assert not any(tmp_path.iterdir())
