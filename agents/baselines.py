@@ -60,14 +60,18 @@ class HeuristicPolicy:
         return self.controller.act(obs)
 
 
-def tuned_heuristic(mode):
-    """The scripted controller's tuned parameters for action mode ``mode`` (a dict; empty if none)."""
+def heuristic_table():
+    """The tuned controllers' parameters of ``hyperparams/heuristic.yml``: env id -> dict."""
     import yaml
 
+    return (yaml.safe_load(HEURISTIC_PARAMS.read_text()) if HEURISTIC_PARAMS.exists() else None) or {}
+
+
+def tuned_heuristic(mode):
+    """The scripted controller's tuned parameters for action mode ``mode`` (a dict; empty if none)."""
     from ballenv.envs import ENV_IDS
 
-    table = yaml.safe_load(HEURISTIC_PARAMS.read_text()) if HEURISTIC_PARAMS.exists() else {}
-    return dict((table or {}).get(ENV_IDS[mode]) or {})
+    return dict(heuristic_table().get(ENV_IDS[mode]) or {})
 
 
 class ModelPolicy:

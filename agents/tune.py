@@ -24,7 +24,7 @@ import pathlib
 import numpy as np
 import yaml
 
-from .baselines import HEURISTIC_PARAMS, HeuristicPolicy
+from .baselines import HEURISTIC_PARAMS, HeuristicPolicy, heuristic_table
 from .evaluate import evaluate
 
 # name -> (low, high, log scale) of each controller parameter
@@ -66,7 +66,7 @@ def tune_heuristic(args):
     if not args.dry_run:
         from ballenv.envs import ENV_IDS
 
-        table = yaml.safe_load(HEURISTIC_PARAMS.read_text()) or {} if HEURISTIC_PARAMS.exists() else {}
+        table = heuristic_table()
         table[ENV_IDS[args.action_mode]] = best
         header = (
             "# The scripted controllers' parameters, tuned by `python -m agents.tune heuristic` (Optuna\n"
