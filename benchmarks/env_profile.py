@@ -14,6 +14,9 @@ the Newton iterations. The time of a control step is then split into phases, eac
   the iterations per control step;
 * the rest of the physics: predictor, contact bookkeeping, energy guard, events, observation and
   reward (the batch call less dispatch less Newton).
+
+Then the cold start: ``gym.make`` + ``reset`` and the first ``step`` in a fresh interpreter with an
+empty numba cache (everything compiles), and again from the cache that run left.
 """
 
 import os
@@ -27,6 +30,7 @@ import time  # noqa: E402
 import gymnasium as gym  # noqa: E402
 import numpy as np  # noqa: E402
 from numba import njit  # noqa: E402
+from step_cost import compile_times  # noqa: E402
 
 import ballenv  # noqa: E402, F401
 from ballenv.envs import ENV_ID  # noqa: E402
@@ -46,6 +50,18 @@ from ballenv.physics.model import build_workspace  # noqa: E402
 from ballenv.physics.presets import FIDELITY_PRESETS  # noqa: E402
 
 RESULTS = pathlib.Path(__file__).parent / "results"
+_COLD_START_SNIPPET = f"""
+import time
+t0 = time.perf_counter()
+import gymnasium as gym
+import ballenv
+env = gym.make({ENV_ID!r})
+env.reset(seed=0)
+t1 = time.perf_counter()
+env.step(env.action_space.sample())
+t2 = time.perf_counter()
+print(t1 - t0, t2 - t1)
+"""
 MODES = ("pressure", "paddle")
 CONTROL_STEPS = 2000
 REPEATS = 3
@@ -201,7 +217,11 @@ def table(rows):
 def main(argv=None):
     presets = (argv or sys.argv[1:]) or tuple(FIDELITY_PRESETS)
     rows = [profile(preset, mode) for preset in presets for mode in MODES]
-    text = table(rows)
+    reset, first_step, cached_step = compile_times(_COLD_START_SNIPPET)
+    text = table(rows) + (
+        f"\nCold start (default env, fresh interpreter, empty numba cache): import, make and reset "
+        f"{reset:.1f} s, first step {first_step:.1f} s; from the cache: first step {cached_step:.2f} s.\n"
+    )
     RESULTS.mkdir(exist_ok=True)
     (RESULTS / "env_profile.md").write_text(text)
     print(text)

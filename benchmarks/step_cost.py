@@ -61,14 +61,15 @@ print(t1 - t0, t2 - t1)
 """
 
 
-def compile_times():
-    """(import s, cold compile s, cached start s) in fresh interpreters with an empty numba cache."""
+def compile_times(snippet=_COMPILE_SNIPPET):
+    """(import s, cold compile s, cached start s): ``snippet`` (which prints the seconds of its import
+    and of its first compiled call) run twice in fresh interpreters sharing an empty numba cache."""
     with tempfile.TemporaryDirectory() as cache:
         env = dict(os.environ, NUMBA_CACHE_DIR=cache)
         runs = []
         for _ in range(2):
             out = subprocess.run(
-                [sys.executable, "-c", _COMPILE_SNIPPET], env=env, capture_output=True, text=True, check=True
+                [sys.executable, "-c", snippet], env=env, capture_output=True, text=True, check=True
             )
             runs.append([float(v) for v in out.stdout.split()])
     return runs[0][0], runs[0][1], runs[1][1]

@@ -17,13 +17,13 @@ from concurrent.futures import ThreadPoolExecutor
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
 
 from ..physics.actuation import apply_impulse, rest_circle_radius, restart, set_gas, set_rest_pressure
 from ..physics.contact import FREE
 from ..physics.effects.gas import ring_pressure
 from ..physics.geometry import centre_of_mass
 from ..physics.integrator import build_solver
+from ..physics.jit import kernel
 from ..physics.layout import (
     CLOCK_H,
     COUNT_EVENTS,
@@ -126,19 +126,19 @@ class Task(NamedTuple):
     end: np.ndarray  # (E,) int64: END_NONE, END_REST, END_ARENA or END_FAILURE
 
 
-@njit(cache=True)
+@kernel
 def env_model(model, e):
     """The one-ring Model of env ``e`` (views of its per-ring fields, ``model.PER_RING_FIELDS``)."""
     return rings_view(model, e, e + 1)
 
 
-@njit(cache=True)
+@kernel
 def env_state(state, e):
     """The one-ring State of env ``e`` (views of its slices)."""
     return rings_view(state, e, e + 1)
 
 
-@njit(cache=True)
+@kernel
 def reset_env(
     model,
     solver,
@@ -206,7 +206,7 @@ def reset_env(
     _clip(obs[e], low, high, out[e])
 
 
-@njit(cache=True)
+@kernel
 def _rise(me, se, task, e):
     """Height (m) the ball's centre could still rise: free energy (kinetic, elastic and gas above the
     inflated circle at rest) over ``m g``, plus the centre's height above its resting height."""
@@ -216,7 +216,7 @@ def _rise(me, se, task, e):
     return se.energy[0, ENERGY_FREE] / weight + cy - task.ground_height - task.rest_radius[e]
 
 
-@njit(cache=True)
+@kernel
 def _top(x):
     """Height (m) of the highest node."""
     top = -math.inf
@@ -225,7 +225,7 @@ def _top(x):
     return top
 
 
-@njit(cache=True)
+@kernel
 def _paddle_ready(task, e, x, v):
     """Whether the paddle can strike env ``e``'s ball (positions ``x``, velocities ``v``): paddle
     mode, the ball falling (its centre of mass moving down) with its top within ``paddle_reach`` of
@@ -239,7 +239,7 @@ def _paddle_ready(task, e, x, v):
     return falling < 0.0 and abs(_top(x) - task.paddle_height[e]) <= task.paddle_reach
 
 
-@njit(cache=True)
+@kernel
 def _actuate(me, se, task, e, action, ws, nodes):
     x = se.x[0]
     n = x.shape[0]
@@ -267,7 +267,7 @@ def _actuate(me, se, task, e, action, ws, nodes):
     task.struck[e] = True
 
 
-@njit(cache=True)
+@kernel
 def _tally(task, e, events, n_events):
     for k in range(n_events):
         kind = int(events[k, EVENT_KIND])
@@ -284,7 +284,7 @@ def _tally(task, e, events, n_events):
             task.last_apex[e] = h
 
 
-@njit(cache=True)
+@kernel
 def step_env(
     model, solver, ws, state, trial, clocks, counters, records, events, task, e, action, nodes, obs, low,
     high, out,
@@ -320,7 +320,7 @@ def step_env(
     _outcome(task, e, obs[e], state.x.shape[1])
 
 
-@njit(cache=True, nogil=True)
+@kernel(nogil=True)
 def step_batch(
     model, solver, ws, state, trial, clocks, counters, records, events, task, actions, active, nodes, obs,
     low, high, out,
@@ -336,13 +336,13 @@ def step_batch(
             )  # fmt: skip
 
 
-@njit(cache=True)
+@kernel
 def _clip(row, low, high, out):
     for k in range(row.shape[0]):
         out[k] = min(high[k], max(low[k], row[k]))
 
 
-@njit(cache=True)
+@kernel
 def predicted_apex(task, e, row, n):
     """Height (m) of the flight apex the reward measures, from env ``e``'s observation ``row``: while
     the ball rises in flight, the centre of mass's ballistic apex ``y + v_y^2 / (2 g)`` (exact: only
@@ -358,7 +358,7 @@ def predicted_apex(task, e, row, n):
     return min(task.last_apex[e], task.rest_radius[e] + task.rise[e])
 
 
-@njit(cache=True)
+@kernel
 def height_reward(error, margin):
     """DeepMind Control's gaussian ``tolerance``: 1 at relative error 0, ``REWARD_AT_MARGIN`` at
     ``margin``, ``exp(-(s error / margin)^2 / 2)`` with ``s = sqrt(-2 ln REWARD_AT_MARGIN)``; in
@@ -367,7 +367,7 @@ def height_reward(error, margin):
     return math.exp(-0.5 * x * x)
 
 
-@njit(cache=True)
+@kernel
 def _outcome(task, e, row, n):
     """Reward and end of env ``e`` after a control step (see ``InflatedBallEnv``'s Rewards): the
     :func:`height_reward` of the relative error ``|h - h_t| / h_t`` of the :func:`predicted_apex`
@@ -392,7 +392,7 @@ def _outcome(task, e, row, n):
     task.reward[e, REWARD_HEIGHT] = height
 
 
-@njit(cache=True)
+@kernel
 def observe_env(model, state, task, e, row):
     """Write env ``e``'s observation (the fields of ``observation.FIELDS``, unclipped) into ``row``."""
     n = state.x.shape[1]

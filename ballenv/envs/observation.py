@@ -15,7 +15,8 @@ from collections.abc import Callable
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
+
+from ..physics.jit import kernel
 
 MAX_SPEED = 100.0  # m/s, bound of the velocity observations
 MAX_NODE_FORCE = 1e5  # N, bound of the per-node ground normal force observation
@@ -126,7 +127,7 @@ OBS_PADDLE_IN_REACH = _START["paddle_in_reach"]
 OBS_PADDLE_IMPULSE = _START["paddle_impulse"]
 
 
-@njit(cache=True)
+@kernel
 def field_start(field, n_nodes):
     """Index of the first entry of ``field`` (an ``OBS_*`` constant) for a ring of ``n_nodes`` nodes."""
     return field[0] * n_nodes + field[1]

@@ -19,24 +19,23 @@ first step at a large ``omega h`` overshoots, and with random gas commands the e
 
 import math
 
-from numba import njit
-
 from .assembly import gravity_column, ring_energy, ring_force
 from .contact import FREE
 from .energy import free_energy
 from .geometry import polygon_area
+from .jit import kernel
 from .layout import ENERGY_BUDGET, ENERGY_TOTAL
 from .ring import inflation_ratio_of
 
 
-@njit(cache=True)
+@kernel
 def rest_circle_radius(model, r, pressure, n_nodes):
     """Radius (m) of ring ``r``'s inflated circle at rest for gauge pressure ``pressure`` (Pa)."""
     q = inflation_ratio_of(pressure, model.width[r], model.radius[r], n_nodes, model.ea[r])
     return model.radius[r] / (1.0 - q)
 
 
-@njit(cache=True)
+@kernel
 def set_rest_pressure(model, r, pressure, x, v, energy, ws):
     """Set ring ``r``'s gas to the amount with gauge pressure ``pressure`` (Pa) at rest
     (:func:`set_gas`), then recount its carried ``energy`` (columns ``layout.ENERGY``;
@@ -45,7 +44,7 @@ def set_rest_pressure(model, r, pressure, x, v, energy, ws):
     recount_energy(model, r, x, v, energy, ws)
 
 
-@njit(cache=True)
+@kernel
 def set_gas(model, r, pressure, n, ws):
     """The gas amount of ring ``r`` (``n`` nodes) whose gauge pressure on its inflated circle at rest
     is ``pressure`` (Pa) (see module doc): updates ``model.gas_constant[r]`` and
@@ -66,7 +65,7 @@ def set_gas(model, r, pressure, n, ws):
     model.rest_energy[r] = total - (ws.energy[g] if g >= 0 else 0.0)
 
 
-@njit(cache=True)
+@kernel
 def apply_impulse(model, r, x, v, energy, ws, nodes, count, jx, jy):
     """Add momentum ``(jx, jy)`` (N s) to ring ``r``, shared equally by ``nodes[:count]``, and
     recount its carried ``energy`` (:func:`recount_energy`)."""
@@ -81,7 +80,7 @@ def apply_impulse(model, r, x, v, energy, ws, nodes, count, jx, jy):
     recount_energy(model, r, x, v, energy, ws)
 
 
-@njit(cache=True)
+@kernel
 def recount_energy(model, r, x, v, energy, ws):
     """Recompute ring ``r``'s carried energy (columns ``layout.ENERGY``) after an actuation; the
     change of energy is added to the ring's energy budget."""
@@ -90,7 +89,7 @@ def recount_energy(model, r, x, v, energy, ws):
     energy[ENERGY_BUDGET] += energy[ENERGY_TOTAL] - before
 
 
-@njit(cache=True)
+@kernel
 def restart(model, r, x, v, a, active, energy, ws):
     """Start ring ``r`` afresh from ``x, v``: its carried energy (:func:`recount_energy`) and start
     acceleration ``a = F / m`` (normal part zeroed on ground-constrained nodes, which rest on the

@@ -14,10 +14,11 @@ argument typing: a call from Python costs about a microsecond, not forty.)
 import importlib
 
 import numpy as np
-from numba import njit, types
+from numba import types
 from numba.extending import overload
 
 from .effects import EFFECTS
+from .jit import kernel
 from .linalg import MAX_LOW_RANK
 
 NO_PARAMETERS = np.zeros(0)  # ``p`` of an effect without parameters of its own (a compiled constant)
@@ -90,8 +91,8 @@ def _unrolled(effects, signature, body, returns):
     scope = {"NO_PARAMETERS": NO_PARAMETERS}
     lines = [f"def impl({signature}):"]
     for k, effect in enumerate(effects):
-        for kernel in ("on", "force", "jacobian", "energy"):
-            scope[f"{kernel}_{k}"] = getattr(effect, kernel)
+        for part in ("on", "force", "jacobian", "energy"):
+            scope[f"{part}_{k}"] = getattr(effect, part)
         view = (
             f"model.effect_parameters[r][{field_name(k, effect)!r}]" if effect.PARAMETERS else "NO_PARAMETERS"
         )
@@ -175,14 +176,14 @@ def _gravity_column(model):
 
 
 # ------------------------------------------------------------------------------- a ring's sums
-@njit(cache=True)
+@kernel
 def ring_force(model, r, x, v, f):
     """Total force (N) on the nodes of ring ``r``, written to ``f``; only the effects that are on."""
     f[:, :] = 0.0
     sum_forces(model, r, x, v, f)
 
 
-@njit(cache=True)
+@kernel
 def ring_jacobian(model, r, x, v, c_mass, c_x, c_v, ws):
     """Assemble ``c_M M - c_x dF/dx - c_v dF/dv`` as band ``ws.band`` + ``ws.u ws.w^T``; return rank."""
     band = ws.band
@@ -197,7 +198,7 @@ def ring_jacobian(model, r, x, v, c_mass, c_x, c_v, ws):
     return sum_jacobians(model, r, x, v, -c_x, -c_v, ws, 0)
 
 
-@njit(cache=True)
+@kernel
 def ring_energy(model, r, x, v, parts):
     """Energy (J) of ring ``r`` by part into ``parts`` (columns :func:`energy_parts` of the model's
     effects); returns their sum."""

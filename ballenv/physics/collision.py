@@ -62,9 +62,8 @@ flat until its top touches its bottom) get no impulse, only the rejection.
 
 import math
 
-from numba import njit
-
 from .cyclic import next_node, prev_node
+from .jit import copy_into, kernel
 
 # contact row: ring a, node i of a, ring b, edge j of b (nodes j, j+1), t in [0, 1], signed distance
 CONTACT_COLUMNS = 6
@@ -75,7 +74,7 @@ RELAXATION_TIME = 1e-2  # s: a node found inside the contact distance is pushed 
 
 
 # ------------------------------------------------------------------------------------ broad phase
-@njit(cache=True)
+@kernel
 def ring_boxes(x, box):
     """``box[r] = (xmin, ymin, xmax, ymax)`` (m) of ring ``r``'s nodes."""
     for r in range(x.shape[0]):
@@ -92,7 +91,7 @@ def ring_boxes(x, box):
         box[r, 3] = y_hi
 
 
-@njit(cache=True)
+@kernel
 def overlapping_pairs(box, margin, order, pairs):
     """Ring pairs (a, b), a < b, whose boxes grown by ``margin[a]`` and ``margin[b]`` (m) overlap,
     into ``pairs``; returns their number.
@@ -129,7 +128,7 @@ def overlapping_pairs(box, margin, order, pairs):
 
 
 # ----------------------------------------------------------------------------------- narrow phase
-@njit(cache=True)
+@kernel
 def orientation(x):
     """+1 for a counter-clockwise polygon (positive shoelace area), -1 otherwise."""
     a = 0.0
@@ -140,7 +139,7 @@ def orientation(x):
     return 1.0 if a >= 0.0 else -1.0
 
 
-@njit(cache=True)
+@kernel
 def locate_point(px, py, poly):
     """Where the point (px, py) lies relative to the closed polygon ``poly`` (N, 2).
 
@@ -176,7 +175,7 @@ def locate_point(px, py, poly):
     return inside, best_j, best_t, math.sqrt(best)
 
 
-@njit(cache=True)
+@kernel
 def _record_contact(px, py, poly, a, i, b, reach, contacts, count):
     """Locate node ``i`` of ring ``a`` at ``(px, py)`` against ring ``b``'s polygon ``poly``; if
     its signed distance (m, negative inside) is below ``reach``, append the row
@@ -195,7 +194,7 @@ def _record_contact(px, py, poly, a, i, b, reach, contacts, count):
     return count
 
 
-@njit(cache=True)
+@kernel
 def _pair_contacts(x, a, b, reach, box, contacts, count):
     """Contacts of the nodes of ring ``a`` within ``reach`` (m) of ring ``b``'s centreline."""
     poly = x[b]
@@ -209,7 +208,7 @@ def _pair_contacts(x, a, b, reach, box, contacts, count):
     return count
 
 
-@njit(cache=True)
+@kernel
 def find_contacts(x, thickness, cw):
     """Every node within the contact distance ``h_a + h_b`` of another ring's centreline (or inside
     it), as rows of ``cw.contacts`` (see ``CONTACT_COLUMNS``); returns their number.
@@ -230,7 +229,7 @@ def find_contacts(x, thickness, cw):
     return count
 
 
-@njit(cache=True)
+@kernel
 def find_contacts_all_pairs(x, thickness, contacts):
     """The paper's first implementation: every node against every other ring, no broad phase.
     O((R N)^2); the reference :func:`find_contacts` is tested and benchmarked against."""
@@ -247,7 +246,7 @@ def find_contacts_all_pairs(x, thickness, contacts):
 
 
 # --------------------------------------------------------------------------------------- response
-@njit(cache=True)
+@kernel
 def _edge_normal(poly, j, sign):
     """Unit outward normal of edge ``j`` (node j to j+1) of a polygon of orientation ``sign``."""
     q = next_node(j, poly.shape[0])
@@ -257,7 +256,7 @@ def _edge_normal(poly, j, sign):
     return s * ey, -s * ex
 
 
-@njit(cache=True)
+@kernel
 def _node_normal(poly, k, sign):
     """Outward unit normal at node ``k``: the mean of its two edges' normals."""
     ax, ay = _edge_normal(poly, prev_node(k, poly.shape[0]), sign)
@@ -269,7 +268,7 @@ def _node_normal(poly, k, sign):
     return nx / length, ny / length
 
 
-@njit(cache=True)
+@kernel
 def outward_normal(poly, j, t, sign):
     """Outward unit normal of the polygon at the foot ``t`` on edge ``j``: the node normals of the
     edge's ends interpolated linearly in ``t`` (then normalised), so the direction turns smoothly
@@ -288,7 +287,7 @@ def outward_normal(poly, j, t, sign):
     return nx / length, ny / length
 
 
-@njit(cache=True)
+@kernel
 def _kick(v, h, node_mass, a, i, b, j, t, nx, ny, signed, delta, relax, kicked):
     """Add the impulse of a contact of node ``i`` of ring ``a`` with edge ``j`` of ring ``b`` (foot
     ``t``, normal ``(nx, ny)`` toward the node, predicted distance ``signed``) to ``kicked``."""
@@ -314,7 +313,7 @@ def _kick(v, h, node_mass, a, i, b, j, t, nx, ny, signed, delta, relax, kicked):
     kicked[b, q, 1] -= t * jb * ny
 
 
-@njit(cache=True)
+@kernel
 def _nearest_own_edge(pred, edge, r, i, step, arc0, best, best_j, best_t):
     """Scan ring ``r``'s edges from node ``i`` along the ring in direction ``step`` (+1 or -1):
     skip the edges whose nearest end lies less than ``arc0`` (m, arc length at the predicted
@@ -352,7 +351,7 @@ def _nearest_own_edge(pred, edge, r, i, step, arc0, best, best_j, best_t):
     return best, best_j, best_t
 
 
-@njit(cache=True)
+@kernel
 def _self_contacts(x, pred, edge, v, h, r, delta, relax, node_mass, kicked):
     """Impulses between node ``i`` of ring ``r`` and the nearest edge of its own ring closer than
     ``delta`` at the predicted positions, among the ``SELF_CONTACT_WINDOW`` edges on each side that
@@ -386,14 +385,14 @@ def _self_contacts(x, pred, edge, v, h, r, delta, relax, node_mass, kicked):
     return count
 
 
-@njit(cache=True)
+@kernel
 def collision_impulses(x, v, h, thickness, node_mass, rings, self_contact, cw, kicked, kinetic_change):
     """Velocities ``kicked`` (R, N, 2, m/s) after the collision impulses of a step of size ``h``
     (s) from nodes ``x`` (m) moving at ``v`` (m/s): between rings if ``rings``, within each ring if
     ``self_contact``; see the module docstring. ``kinetic_change[r]`` receives the change of ring
     r's kinetic energy (J). Returns the number of contacts (found on the predicted positions
     ``x + h v``, kept in ``cw.predicted``)."""
-    kicked[:, :, :] = v
+    copy_into(kicked, v)
     pred = cw.predicted
     for r in range(x.shape[0]):
         for i in range(x.shape[1]):
@@ -439,7 +438,7 @@ def collision_impulses(x, v, h, thickness, node_mass, rings, self_contact, cw, k
     return count
 
 
-@njit(cache=True)
+@kernel
 def rings_intrude(x, thickness, cw):
     """True if a node of one ring is inside another ring's centreline polygon."""
     count = find_contacts(x, thickness, cw)
@@ -449,7 +448,7 @@ def rings_intrude(x, thickness, cw):
     return False
 
 
-@njit(cache=True)
+@kernel
 def collision_step_limit(x, v, thickness, h, cw):
     """Largest step (s, at most ``h``) in which no node can move more than half the contact
     distance into a ring it could reach.
@@ -499,7 +498,7 @@ def collision_step_limit(x, v, thickness, h, cw):
 
 
 # ----------------------------------------------------------------------------------- self-contact
-@njit(cache=True)
+@kernel
 def _star_shaped(x):
     """True if every node is seen from the centroid at a strictly increasing angle (one turn):
     the polygon is then star-shaped about its centroid, hence simple. O(N)."""
@@ -523,7 +522,7 @@ def _star_shaped(x):
     return abs(turn - 2.0 * math.pi) < 1e-6
 
 
-@njit(cache=True)
+@kernel
 def _segments_cross(ax, ay, bx, by, cx, cy, dx, dy):
     """True if the closed segments ab and cd share a point (orientation test)."""
     d1 = (dx - cx) * (ay - cy) - (dy - cy) * (ax - cx)
@@ -535,7 +534,7 @@ def _segments_cross(ax, ay, bx, by, cx, cy, dx, dy):
     )
 
 
-@njit(cache=True)
+@kernel
 def self_intersects(x):
     """True if two non-adjacent edges of the ring's polygon ``x`` (N, 2) cross or touch."""
     if _star_shaped(x):

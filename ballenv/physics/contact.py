@@ -19,15 +19,14 @@ released; a free node below a ground is constrained.
 
 import math
 
-from numba import njit
-
+from .jit import kernel
 from .linalg import BAND_HALF_WIDTH
 
 FREE = -1
 PENETRATION_TOLERANCE = -1e-12  # m: a free node deeper than this below a ground gets constrained
 
 
-@njit(cache=True)
+@kernel
 def deepest_ground(grounds, x, y):
     """(ground index, signed distance in m) of the ground the point is deepest below (or nearest)."""
     best = 0
@@ -40,7 +39,7 @@ def deepest_ground(grounds, x, y):
     return best, best_phi
 
 
-@njit(cache=True)
+@kernel
 def constrain_residual(grounds, active, x1, ve, res, node_mass, c_mass, eps, reaction, friction):
     """Replace the rows of active nodes (see module doc); store their normal reaction N_i (N) in
     ``reaction`` and the friction force along t (N) in ``friction``."""
@@ -70,7 +69,7 @@ def constrain_residual(grounds, active, x1, ve, res, node_mass, c_mass, eps, rea
             res[2 * i], res[2 * i + 1] = row_t, row_n
 
 
-@njit(cache=True)
+@kernel
 def constrain_jacobian(grounds, active, ve, reaction, band, pos, u, rank, node_mass, c_mass, c_v, eps):
     """Apply the row combinations of :func:`constrain_residual` to the band and to the rows of the
     low-rank factor ``u`` (natural order)."""
@@ -120,7 +119,7 @@ def constrain_jacobian(grounds, active, ve, reaction, band, pos, u, rank, node_m
                 u[2 * i + 1, k] = 0.0
 
 
-@njit(cache=True)
+@kernel
 def activate_penetrating(grounds, active, x1, only_deeper_than):
     """Constrain free nodes below a ground; returns True if any was added."""
     changed = False
@@ -133,7 +132,7 @@ def activate_penetrating(grounds, active, x1, only_deeper_than):
     return changed
 
 
-@njit(cache=True)
+@kernel
 def rest_on_grounds(grounds, active, v1, a1):
     """A constrained node ends the step at rest in the ground's normal direction (normal velocity
     and algorithmic acceleration zeroed): it sits on the surface. Without this, backward Euler's

@@ -11,17 +11,16 @@ actuation and collision impulses gave it since). The energy parts come from the 
 
 import math
 
-from numba import njit
-
 from .assembly import gravity_column, ring_energy
 from .contact import rest_on_grounds
 from .geometry import centre_of_mass
+from .jit import kernel
 from .layout import ENERGY_BUDGET, ENERGY_FREE, ENERGY_TOTAL, TALLY_PROJECTED, TALLY_REMOVED
 
 ENERGY_GROWTH_TOL = 1e-2  # largest energy gain of a step, relative to the ring's free energy
 
 
-@njit(cache=True)
+@kernel
 def free_energy(model, r, x, v, parts, out):
     """``out[ENERGY_TOTAL]`` = the energy (J) of ring ``r``; ``out[ENERGY_FREE]`` = its free part:
     kinetic plus elastic and gas energy above the inflated circle at rest (``Model.rest_energy``),
@@ -31,7 +30,7 @@ def free_energy(model, r, x, v, parts, out):
     out[ENERGY_FREE] = out[ENERGY_TOTAL] - (parts[g] if g >= 0 else 0.0) - model.rest_energy[r]
 
 
-@njit(cache=True)
+@kernel
 def energy_grew(total_before, free_before, total_after, free_after):
     """True if a step from energy ``total_before`` to ``total_after`` (J; ``free_``: their free
     parts, see :func:`free_energy`) raised the total by more than ``ENERGY_GROWTH_TOL`` times the
@@ -42,7 +41,7 @@ def energy_grew(total_before, free_before, total_after, free_after):
     return total_after - total_before > ENERGY_GROWTH_TOL * free + 1e-12 * abs(total_before)
 
 
-@njit(cache=True)
+@kernel
 def _energy_scale(model, r, x, parts):
     """Size (J) of the terms that make up ring ``r``'s energy, for round-off tolerances: the sum of
     |energy parts| ``parts``, with gravity's part taken node by node, ``m |g_d x_i,d|`` summed
@@ -59,7 +58,7 @@ def _energy_scale(model, r, x, parts):
     return scale
 
 
-@njit(cache=True)
+@kernel
 def within_energy_budget(model, r, before, kick, trial, ws):
     """Hold ring ``r``'s energy after a trial step to its budget ``trial.energy[r, ENERGY_BUDGET]``
     (J): its energy at the start of the run plus what actuation and collision impulses gave it
@@ -97,7 +96,7 @@ def within_energy_budget(model, r, before, kick, trial, ws):
     return True
 
 
-@njit(cache=True)
+@kernel
 def remove_internal_kinetic_energy(x, v, m, excess):
     """Lower the kinetic energy of a ring (nodes ``x`` (N, 2) m, velocities ``v`` (N, 2) m/s, equal
     node masses ``m`` kg) by ``excess`` (J) without changing its momentum: the velocities relative

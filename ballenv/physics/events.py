@@ -13,10 +13,10 @@ kind ``layout.EVENT_KINDS`` (0 = touchdown, 1 = liftoff, 2 = apex).
 """
 
 import numpy as np
-from numba import njit
 
 from .contact import FREE, deepest_ground
 from .geometry import centre_of_mass
+from .jit import kernel
 from .layout import (
     EVENT_APEX,
     EVENT_HEIGHT,
@@ -31,14 +31,14 @@ from .layout import (
 __all__ = ["EVENT_APEX", "EVENT_KINDS", "EVENT_LIFTOFF", "EVENT_TOUCHDOWN", "detect_events", "event_list"]
 
 
-@njit(cache=True)
+@kernel
 def _height(x, v):
     """Centre-of-mass height (m) and vertical velocity (m/s)."""
     _, cy, _, vy = centre_of_mass(x, v)
     return cy, vy
 
 
-@njit(cache=True)
+@kernel
 def _hermite(y0, y1, d0, d1, s):
     """Cubic Hermite on [0, 1] with end values y0, y1 and end slopes d0, d1 (per unit s)."""
     s2 = s * s
@@ -46,7 +46,7 @@ def _hermite(y0, y1, d0, d1, s):
     return (2 * s3 - 3 * s2 + 1) * y0 + (s3 - 2 * s2 + s) * d0 + (-2 * s3 + 3 * s2) * y1 + (s3 - s2) * d1
 
 
-@njit(cache=True)
+@kernel
 def _write(events, n_events, t, ring, kind, height):
     """Write event row ``n_events`` (columns ``layout.EVENT``); return the new count."""
     events[n_events, EVENT_T] = t
@@ -56,7 +56,7 @@ def _write(events, n_events, t, ring, kind, height):
     return n_events + 1
 
 
-@njit(cache=True)
+@kernel
 def detect_events(model, state, trial, t, h, events, n_events):
     """Append the events of the step ``state -> trial`` over ``[t, t + h]``; return the new count."""
     n_rings = state.x.shape[0]

@@ -3,12 +3,11 @@
 Nodes ``x`` (N, 2) in metres, velocities ``v`` (N, 2) in m/s, equal node masses.
 """
 
-from numba import njit
-
 from .cyclic import next_node
+from .jit import kernel
 
 
-@njit(cache=True)
+@kernel
 def polygon_area(x):
     """Shoelace area (m^2) of the ring's polygon; positive for counter-clockwise nodes."""
     n = x.shape[0]
@@ -19,7 +18,7 @@ def polygon_area(x):
     return 0.5 * a
 
 
-@njit(cache=True)
+@kernel
 def centre_of_mass(x, v):
     """Centre of mass (m) and its velocity (m/s) of nodes of equal mass: ``(cx, cy, vx, vy)``."""
     n = x.shape[0]
@@ -32,7 +31,7 @@ def centre_of_mass(x, v):
     return cx / n, cy / n, vx / n, vy / n
 
 
-@njit(cache=True)
+@kernel
 def rigid_motion(x, v):
     """Centre of mass (m), its velocity (m/s), spin ``omega`` (rad/s) and ``sum |r|^2`` (m^2).
 

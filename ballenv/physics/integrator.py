@@ -19,7 +19,7 @@ which the step-size control nets out. Nothing outside this module branches on th
 
 from typing import NamedTuple
 
-from numba import njit
+from .jit import kernel
 
 METHOD_BACKWARD_EULER = 0
 METHOD_GENERALIZED_ALPHA = 1
@@ -79,13 +79,13 @@ def build_solver(scene):
     )
 
 
-@njit(cache=True)
+@kernel
 def carries_acceleration(solver):
     """The method carries the acceleration ``a`` from step to step (generalized-alpha)."""
     return solver.method != METHOD_BACKWARD_EULER
 
 
-@njit(cache=True)
+@kernel
 def coefficients(solver, h):
     """``(c_M, c_x, c_v, alpha_m)`` of a step ``h`` (s): the Jacobian is ``c_M M - c_x dF/dx - c_v
     dF/dv``; a constant extra force ``F`` moves a free node of mass ``m`` by ``F / (c_M m)``."""
@@ -97,7 +97,7 @@ def coefficients(solver, h):
     return c_mass, c_x, c_v, solver.alpha_m
 
 
-@njit(cache=True)
+@kernel
 def arrival_factor(solver):
     """Reaction impulse per unit momentum that stops a node arriving at a ground: 1 for backward
     Euler, ``(1 - alpha_m) / beta`` for generalized-alpha (whose Newmark update reflects the node's
@@ -107,7 +107,7 @@ def arrival_factor(solver):
     return (1.0 - solver.alpha_m) / solver.beta
 
 
-@njit(cache=True)
+@kernel
 def predict(solver, v0, a0, h, dx):
     """The predictor of the step's displacement ``dx`` (m): ``h v0`` (backward Euler), ``h v0 +
     h^2 a0 / 2`` (generalized-alpha)."""
@@ -118,7 +118,7 @@ def predict(solver, v0, a0, h, dx):
                 dx[i, d] += 0.5 * h * h * a0[i, d]
 
 
-@njit(cache=True)
+@kernel
 def kinematics(solver, x0, v0, a0, h, x1, v1, a1, ws):
     """From the step's displacement ``ws.dx``: ``x1``, ``v1``, ``a1`` and the force evaluation point
     ``ws.xe``, ``ws.ve``. Working with the displacement (not ``x1``) keeps ``a1`` free of the

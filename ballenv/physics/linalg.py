@@ -18,11 +18,13 @@ passed to the solver are in natural DOF order (``2 * node + component``).
 """
 
 import numpy as np
-from numba import njit
+
+from .jit import kernel
 
 BAND_HALF_WIDTH = 9
 BAND_COLUMNS = 2 * BAND_HALF_WIDTH + 1
 MAX_LOW_RANK = 4
+SOLVE_COLUMNS = 1 + MAX_LOW_RANK  # the right-hand side and the low-rank columns, solved together
 
 
 def zigzag_positions(n_nodes):
@@ -41,7 +43,7 @@ def zigzag_positions(n_nodes):
     return pos
 
 
-@njit(cache=True)
+@kernel
 def band_add_block(band, pos, i, j, a00, a01, a10, a11):
     """Add the 2x2 block [[a00, a01], [a10, a11]] at node row ``i``, node column ``j``."""
     r = 2 * pos[i]
@@ -53,9 +55,13 @@ def band_add_block(band, pos, i, j, a00, a01, a10, a11):
     band[r + 1, w + c - r] += a11
 
 
-@njit(cache=True, fastmath=True)
+@kernel(fastmath=True)
 def band_lu(band):
-    """Factorise a band matrix in place (LU, no pivoting). Returns False on a zero/non-finite pivot."""
+    """Factorise a band matrix in place (LU, no pivoting). Returns False on a zero/non-finite pivot.
+
+    Rows more than ``BAND_HALF_WIDTH`` from the end are eliminated with loops of the constant band
+    width (unrolled and vectorised by the compiler; the operations and their order are those of the
+    general loop of the last rows)."""
     n = band.shape[0]
     w = BAND_HALF_WIDTH
     for k in range(n):
@@ -64,46 +70,55 @@ def band_lu(band):
         if not (abs(pivot) > 1e-300) or not np.isfinite(pivot):
             return False
         inv = 1.0 / pivot
-        last = min(n - 1, k + w)
-        count = last - k
-        for i in range(k + 1, last + 1):
-            row_i = band[i]
-            off = w + k - i
-            lik = row_i[off] * inv
-            row_i[off] = lik
-            for j in range(count):
-                row_i[off + 1 + j] -= lik * row_k[w + 1 + j]
+        if k + w < n:
+            for i in range(1, w + 1):
+                _eliminate(band[k + i], row_k, w - i, inv, w)
+        else:
+            for i in range(1, n - k):
+                _eliminate(band[k + i], row_k, w - i, inv, n - 1 - k)
     return True
 
 
-@njit(cache=True, fastmath=True)
+@kernel(fastmath=True, inline="always")
+def _eliminate(row_i, row_k, off, inv, count):
+    """Subtract the multiple of pivot row ``row_k`` that zeroes ``row_i[off]`` (stored as L's entry)
+    from the ``count`` entries of ``row_i`` right of it."""
+    lik = row_i[off] * inv
+    row_i[off] = lik
+    for j in range(count):
+        row_i[off + 1 + j] -= lik * row_k[BAND_HALF_WIDTH + 1 + j]
+
+
+@kernel(fastmath=True)
 def band_lu_solve(lu, b):
-    """Solve (L U) X = B in place for a factor from :func:`band_lu`; ``b`` is (n, k), band order."""
+    """Solve (L U) X = B in place for a factor from :func:`band_lu`; ``b`` is (n, SOLVE_COLUMNS),
+    band order (the constant column count lets the compiler unroll the column loops)."""
     n = lu.shape[0]
     w = BAND_HALF_WIDTH
-    k = b.shape[1]
     for i in range(n):
         row = lu[i]
-        bi = b[i]
-        for j in range(max(0, i - w), i):
-            lij = row[w + j - i]
-            bj = b[j]
-            for c in range(k):
-                bi[c] -= lij * bj[c]
+        first = max(0, i - w)
+        for j in range(first, i):
+            _subtract(b[i], row[w + j - i], b[j])
     for i in range(n - 1, -1, -1):
         row = lu[i]
-        bi = b[i]
-        for j in range(i + 1, min(n, i + w + 1)):
-            uij = row[w + j - i]
-            bj = b[j]
-            for c in range(k):
-                bi[c] -= uij * bj[c]
+        last = min(n, i + w + 1)
+        for j in range(i + 1, last):
+            _subtract(b[i], row[w + j - i], b[j])
         inv = 1.0 / row[w]
-        for c in range(k):
+        bi = b[i]
+        for c in range(SOLVE_COLUMNS):
             bi[c] *= inv
 
 
-@njit(cache=True)
+@kernel(fastmath=True, inline="always")
+def _subtract(bi, factor, bj):
+    """``bi -= factor * bj`` over the ``SOLVE_COLUMNS`` columns."""
+    for c in range(SOLVE_COLUMNS):
+        bi[c] -= factor * bj[c]
+
+
+@kernel
 def _small_solve(a, b, k):
     """Solve a[:k, :k] y = b[:k] in place (Gaussian elimination, partial pivoting). False if singular."""
     for c in range(k):
@@ -130,25 +145,25 @@ def _small_solve(a, b, k):
     return True
 
 
-@njit(cache=True)
+@kernel
 def solve_band_low_rank(band, pos, u, v, rank, rhs, work, cap, coef):
     """Solve (B + U V^T) x = rhs in place, O(N).
 
     ``band`` holds B (band order) and is overwritten by its LU factor; ``u``, ``v`` are (2N, >=rank)
     in natural order; ``rhs`` (2N,) natural order is overwritten by the solution. ``work``
-    (2N, 1 + MAX_LOW_RANK), ``cap`` (MAX_LOW_RANK, MAX_LOW_RANK) and ``coef`` (MAX_LOW_RANK,) are
+    (2N, SOLVE_COLUMNS), ``cap`` (MAX_LOW_RANK, MAX_LOW_RANK) and ``coef`` (MAX_LOW_RANK,) are
     scratch. Returns False if the factorisation breaks down.
     """
     if not band_lu(band):
         return False
     n_nodes = pos.shape[0]
-    cols = work[:, : rank + 1]
+    cols = work
     for node in range(n_nodes):
         p = 2 * pos[node]
         for d in range(2):
             cols[p + d, 0] = rhs[2 * node + d]
-            for c in range(rank):
-                cols[p + d, c + 1] = u[2 * node + d, c]
+            for c in range(MAX_LOW_RANK):
+                cols[p + d, c + 1] = u[2 * node + d, c] if c < rank else 0.0
     band_lu_solve(band, cols)
     if rank > 0:
         for a in range(rank):

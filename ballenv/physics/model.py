@@ -25,7 +25,7 @@ from .collision import CONTACT_COLUMNS, CONTACTS_PER_NODE
 from .effects import EFFECTS
 from .effects.damping import DAMPING_CENTRE_OF_MASS, DAMPING_NONE, DAMPING_RIGID
 from .layout import ENERGY, EVENT, TALLY
-from .linalg import BAND_COLUMNS, MAX_LOW_RANK, zigzag_positions
+from .linalg import BAND_COLUMNS, MAX_LOW_RANK, SOLVE_COLUMNS, zigzag_positions
 
 CONTACT_NONE = 0
 CONTACT_MASS_MODIFICATION = 1
@@ -90,7 +90,7 @@ class Workspace(NamedTuple):
     cap: np.ndarray  # (MAX_LOW_RANK, MAX_LOW_RANK)
     coef: np.ndarray  # (MAX_LOW_RANK,)
     res: np.ndarray  # (2N,)
-    work: np.ndarray  # (2N, 1 + MAX_LOW_RANK)
+    work: np.ndarray  # (2N, SOLVE_COLUMNS)
     force: np.ndarray  # (N, 2)
     dx: np.ndarray  # (N, 2) displacement of the step, the Newton unknown
     delta: np.ndarray  # (N, 2) the last Newton correction (for backtracking)
@@ -219,7 +219,7 @@ def build_workspace(n_nodes, n_rings=1, effects=EFFECTS):
         cap=np.zeros((MAX_LOW_RANK, MAX_LOW_RANK)),
         coef=np.zeros(MAX_LOW_RANK),
         res=np.zeros(n2),
-        work=np.zeros((n2, 1 + MAX_LOW_RANK)),
+        work=np.zeros((n2, SOLVE_COLUMNS)),
         force=np.zeros((n_nodes, 2)),
         dx=np.zeros((n_nodes, 2)),
         delta=np.zeros((n_nodes, 2)),

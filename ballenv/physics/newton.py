@@ -20,8 +20,6 @@ alone does not recover.
 
 import math
 
-from numba import njit
-
 from .assembly import ring_force, ring_jacobian
 from .contact import (
     FREE,
@@ -32,6 +30,7 @@ from .contact import (
     rest_on_grounds,
 )
 from .integrator import coefficients, kinematics, predict
+from .jit import kernel
 from .linalg import solve_band_low_rank
 from .model import CONTACT_MASS_MODIFICATION, CONTACT_NONE
 
@@ -40,7 +39,7 @@ MIN_NEWTON_FRACTION = 1.0 / 32.0  # backtracking halves a correction at most 5 t
 FAILED = -1
 
 
-@njit(cache=True)
+@kernel
 def residual(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active):
     """The residual of the iterate ``ws.dx`` into ``ws.res`` (and ``x1, v1, a1``); returns
     ``(|r|^2, |r|_inf, force scale, finite)``: ``|r|^2`` is inf when a value is not finite."""
@@ -75,7 +74,7 @@ def residual(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active):
     return merit, worst, scale, True
 
 
-@njit(cache=True)
+@kernel
 def correction(model, solver, r, x0, h, ws, active):
     """Solve the Newton system at the iterate and apply the correction to ``ws.dx`` (kept in
     ``ws.delta`` for backtracking). Returns ``(ok, settled)``: ok False on a singular system or a
@@ -108,7 +107,7 @@ def correction(model, solver, r, x0, h, ws, active):
     return True, step <= 1e-13 * size
 
 
-@njit(cache=True)
+@kernel
 def update_contact_set(model, active, x1, reaction):
     """After convergence: free the constrained nodes whose normal reaction ``reaction`` (N) pulls,
     then constrain free nodes below a ground. Returns True if the set changed."""
@@ -122,7 +121,7 @@ def update_contact_set(model, active, x1, reaction):
     return changed
 
 
-@njit(cache=True)
+@kernel
 def backtrack(ws, lam):
     """Take back the fraction ``lam`` of the last correction ``ws.delta`` from ``ws.dx``."""
     dx = ws.dx
@@ -132,7 +131,7 @@ def backtrack(ws, lam):
             dx[i, d] += lam * delta[i, d]
 
 
-@njit(cache=True)
+@kernel
 def newton_ring(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active):
     """Solve one implicit step of ring ``r``; ``x1, v1, a1`` receive the new state.
 

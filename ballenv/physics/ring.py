@@ -26,7 +26,8 @@ must stay below 1 (beyond, no wall tension can hold the gas).
 import math
 
 import numpy as np
-from numba import njit
+
+from .jit import kernel
 
 
 def rest_edge_length(radius, n_nodes):
@@ -64,7 +65,7 @@ def total_mass(ring):
     return ring.n_nodes * node_mass(ring)
 
 
-@njit(cache=True)
+@kernel
 def inflation_ratio_of(pressure, width, radius, n_nodes, ea):
     """``q = p b R cos(pi / N) / EA`` (dimensionless) for gauge pressure ``p`` (Pa)."""
     return pressure * width * radius * math.cos(math.pi / n_nodes) / ea

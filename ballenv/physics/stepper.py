@@ -10,8 +10,6 @@ size. Counters, clock and energy columns are the named layouts of :mod:`.layout`
 
 import math
 
-from numba import njit
-
 from .assembly import ring_force
 from .collision import collision_impulses, collision_step_limit, rings_intrude, self_intersects
 from .contact import FREE
@@ -19,6 +17,7 @@ from .effects.gas import ring_pressure
 from .energy import free_energy, within_energy_budget
 from .events import detect_events
 from .integrator import arrival_factor, carries_acceleration
+from .jit import copy_into, kernel
 from .layout import (
     CLOCK_COLLISION_GAIN,
     CLOCK_ENERGY_REMOVED,
@@ -54,7 +53,7 @@ from .newton import newton_ring
 CONTINUE = -1  # step_outcome(): retry the step
 
 
-@njit(cache=True)
+@kernel
 def initial_state_values(model, solver, state, ws):
     """Fill what the stepper carries besides ``x, v``: every ring's energy (its budget = its energy
     now) and, for an integrator that carries it, its start acceleration."""
@@ -65,7 +64,7 @@ def initial_state_values(model, solver, state, ws):
         initial_acceleration(model, state.x, state.v, state.a, ws)
 
 
-@njit(cache=True)
+@kernel
 def initial_acceleration(model, x, v, a, ws):
     """``a = F(x, v) / m`` for every ring (the generalized-alpha start value)."""
     for r in range(x.shape[0]):
@@ -75,15 +74,15 @@ def initial_acceleration(model, x, v, a, ws):
                 a[r, i, d] = ws.force[i, d] / model.node_mass[r]
 
 
-@njit(cache=True)
+@kernel
 def collision_kicks(model, state, h, ws):
-    """Start velocities of the step: ``state.v``, or with ring collision or self-contact the velocities
-    after the collision impulses (found on the predicted positions ``x0 + h v0``, ``collision.py``)
-    in ``ws.collision.kicked``, each ring's kinetic energy change in ``ws.collision.kinetic_change``
-    and their net gain (J) tallied."""
+    """With ring collision or self-contact: the velocities after the collision impulses (found on the
+    predicted positions ``x0 + h v0``, ``collision.py``) into ``ws.collision.kicked``, each ring's
+    kinetic energy change into ``ws.collision.kinetic_change`` and their net gain (J) tallied;
+    returns True. Without either, returns False: the step starts from ``state.v``."""
     cw = ws.collision
     if not (model.collide or model.reject_self_intersection):
-        return state.v
+        return False
     collision_impulses(
         state.x, state.v, h, model.thickness, model.node_mass, model.collide,
         model.reject_self_intersection, cw, cw.kicked, cw.kinetic_change,
@@ -92,14 +91,14 @@ def collision_kicks(model, state, h, ws):
     for r in range(state.x.shape[0]):
         created += cw.kinetic_change[r]
     ws.energy_tally[TALLY_COLLISION_GAIN] = max(0.0, created)
-    return cw.kicked
+    return True
 
 
-@njit(cache=True)
+@kernel
 def step_ring(model, solver, r, state, v0, trial, h, ws):
     """Ring ``r``'s trial step and its own acceptance tests: returns its Newton corrections, or
     minus the ``REJECT_`` code (Newton failed, the wall crossed itself, the energy budget)."""
-    trial.active[r] = state.active[r]
+    copy_into(trial.active[r], state.active[r])
     its = newton_ring(
         model, solver, r, state.x[r], v0[r], state.a[r], h, trial.x[r], trial.v[r], trial.a[r], ws,
         trial.active[r],
@@ -117,7 +116,7 @@ def step_ring(model, solver, r, state, v0, trial, h, ws):
     return its
 
 
-@njit(cache=True)
+@kernel
 def contact_impulse(model, solver, r, state, v0, trial, h, ws):
     """Ring ``r``'s contact forces into ``trial.contact_force`` and its contact impulse (N s) for the
     step-size control (see :func:`try_step`)."""
@@ -153,7 +152,7 @@ def contact_impulse(model, solver, r, state, v0, trial, h, ws):
     return math.sqrt(jx * jx + jy * jy)
 
 
-@njit(cache=True)
+@kernel
 def try_step(model, solver, state, trial, h, ws):
     """One step of every ring from ``state`` into ``trial``.
 
@@ -189,7 +188,7 @@ def try_step(model, solver, state, trial, h, ws):
     total = 0
     impulse = 0.0
     ws.energy_tally[:] = 0.0
-    v0 = collision_kicks(model, state, h, ws)
+    v0 = ws.collision.kicked if collision_kicks(model, state, h, ws) else state.v
     for r in range(state.x.shape[0]):
         its = step_ring(model, solver, r, state, v0, trial, h, ws)
         if its < 0:
@@ -202,29 +201,29 @@ def try_step(model, solver, state, trial, h, ws):
     return total, impulse
 
 
-@njit(cache=True)
+@kernel
 def record(model, k, t, state, rec):
     """Write ``state`` at time ``t`` (s) as record ``k`` of ``rec``."""
     rec.t[k] = t
-    rec.x[k] = state.x
-    rec.v[k] = state.v
-    rec.contact_force[k] = state.contact_force
+    copy_into(rec.x[k], state.x)
+    copy_into(rec.v[k], state.v)
+    copy_into(rec.contact_force[k], state.contact_force)
     for r in range(state.x.shape[0]):
         rec.pressure[k, r] = ring_pressure(model, r, state.x[r])
 
 
-@njit(cache=True)
+@kernel
 def copy_state(state, trial):
     """``state`` <- ``trial``, field by field."""
-    state.x[:] = trial.x
-    state.v[:] = trial.v
-    state.a[:] = trial.a
-    state.active[:] = trial.active
-    state.contact_force[:] = trial.contact_force
-    state.energy[:] = trial.energy
+    copy_into(state.x, trial.x)
+    copy_into(state.v, trial.v)
+    copy_into(state.a, trial.a)
+    copy_into(state.active, trial.active)
+    copy_into(state.contact_force, trial.contact_force)
+    copy_into(state.energy, trial.energy)
 
 
-@njit(cache=True)
+@kernel
 def step_end(solver, clock, counters, t_end, output_dt):
     """The end of the next step: ``(stop, at_end, at_out, at_grid)``: the time (s) the step from
     ``clock[CLOCK_T]`` with size ``clock[CLOCK_H]`` stops at, shortened to land on the next output
@@ -248,7 +247,7 @@ def step_end(solver, clock, counters, t_end, output_dt):
     return stop, at_end, at_out, at_grid
 
 
-@njit(cache=True)
+@kernel
 def step_outcome(solver, clock, counters, h, its, ratio):
     """Bookkeeping of a trial step of size ``h`` (s) that returned ``its`` Newton corrections and
     ``ratio`` = impulse_tol over its contact impulse:
@@ -272,7 +271,7 @@ def step_outcome(solver, clock, counters, h, its, ratio):
     return STATUS_DONE
 
 
-@njit(cache=True)
+@kernel
 def accept(model, solver, ws, state, trial, clock, counters, h, stop, at_grid, ratio, rec):
     """Take the trial step ``state -> trial`` of size ``h`` (s) ending at ``stop`` (s): tallies,
     events, the state, the clock, and the next step size: adaptive, grown by ``min(growth, 1 +
@@ -295,7 +294,7 @@ def accept(model, solver, ws, state, trial, clock, counters, h, stop, at_grid, r
         clock[CLOCK_H] = solver.dt
 
 
-@njit(cache=True)
+@kernel
 def advance(model, solver, ws, state, trial, clock, counters, t_pause, t_end, output_dt, rec):
     """Step ``state`` from ``clock[CLOCK_T]`` to ``t_end``, pausing (returning) after the first step
     that reaches ``t_pause`` (<= ``t_end``; for progress reports).

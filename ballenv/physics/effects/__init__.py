@@ -12,7 +12,7 @@ attributes:
   per-ring record ``Model.effect_parameters[r]``; the effect sees them as ``p``. The built-in
   effects read named ``Model`` fields and declare none.
 
-and four numba kernels (``@njit(cache=True)``), for ring ``r`` with nodes ``x`` (N, 2) m and
+and four numba kernels (``@kernel`` of :mod:`..jit`), for ring ``r`` with nodes ``x`` (N, 2) m and
 velocities ``v`` (N, 2) m/s:
 
 * ``on(model, p, r) -> bool``: the effect acts on ring ``r`` (checked before every other kernel);

@@ -10,9 +10,8 @@ neighbours on each side (band half-width 2 nodes), exact. Always on.
 
 import math
 
-from numba import njit
-
 from ..cyclic import next_node, prev_node
+from ..jit import kernel
 from ..linalg import band_add_block
 
 NAME = "bending"
@@ -26,31 +25,31 @@ def enabled(scene):
     return True
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def on(model, p, r):
     return True
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def force(model, p, r, x, v, f):
     """Add the bending forces (N) on ring ``r`` to ``f``."""
     bend_force(x, model.rest_len[r], model.ei[r], model.rest_turn[r], f)
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def jacobian(model, p, r, x, v, coef_x, coef_v, ws, rank):
     """Add ``coef_x dF/dx`` to ``ws.band`` (no velocity dependence, no low-rank part)."""
     bend_jacobian(x, model.rest_len[r], model.ei[r], model.rest_turn[r], coef_x, ws.band, ws.pos)
     return rank
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def energy(model, p, r, x, v):
     """Bending energy (J) of ring ``r``."""
     return bend_energy(x, model.rest_len[r], model.ei[r], model.rest_turn[r])
 
 
-@njit(cache=True)
+@kernel
 def _turning_angle(x, i, n):
     p = prev_node(i, n)
     q = next_node(i, n)
@@ -61,7 +60,7 @@ def _turning_angle(x, i, n):
     return math.atan2(e1x * e2y - e1y * e2x, e1x * e2x + e1y * e2y), e1x, e1y, e2x, e2y
 
 
-@njit(cache=True)
+@kernel
 def _direction_gradients(e1x, e1y, e2x, e2y):
     """``g(e1)``, ``g(e2)`` with ``g(e) = (-e_y, e_x) / |e|^2`` (the gradient of the edge's direction
     angle, 1/m), and ``|e1|^2``, ``|e2|^2``."""
@@ -70,7 +69,7 @@ def _direction_gradients(e1x, e1y, e2x, e2y):
     return -e1y / s1, e1x / s1, -e2y / s2, e2x / s2, s1, s2
 
 
-@njit(cache=True)
+@kernel
 def bend_energy(x, rest_len, ei, rest_turn):
     """Bending energy (J) of the ring."""
     n = x.shape[0]
@@ -82,7 +81,7 @@ def bend_energy(x, rest_len, ei, rest_turn):
     return e
 
 
-@njit(cache=True)
+@kernel
 def bend_force(x, rest_len, ei, rest_turn, f):
     """Add the bending forces (N) to ``f``.
 
@@ -105,7 +104,7 @@ def bend_force(x, rest_len, ei, rest_turn, f):
         f[q, 1] += m * g2y
 
 
-@njit(cache=True)
+@kernel
 def bend_jacobian(x, rest_len, ei, rest_turn, coef, band, pos):
     """Add ``coef * dF_b/dx = -coef k [grad phi grad phi^T + (phi - phi0) hess phi]`` to ``band``.
 
@@ -139,7 +138,7 @@ def bend_jacobian(x, rest_len, ei, rest_turn, coef, band, pos):
         _bend_block(band, pos, q, p, c, t, gnx, gny, gpx, gpy, 0.0, 0.0)
 
 
-@njit(cache=True)
+@kernel
 def _bend_block(band, pos, a, b, c, t, gax, gay, gbx, gby, ha, hb):
     """Add ``c (g_a g_b^T + t [[ha, hb], [hb, -ha]])`` at node block (a, b)."""
     band_add_block(

@@ -7,9 +7,8 @@ coupling through the centre of mass and spin is low-rank (2 or 3 columns). Dissi
 On when ``Scene.damping`` is not 0.
 """
 
-from numba import njit
-
 from ..geometry import rigid_motion
+from ..jit import kernel
 from ..linalg import band_add_block
 
 NAME = "damping"
@@ -27,18 +26,18 @@ def enabled(scene):
     return scene.damping != 0.0
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def on(model, p, r):
     return model.damping_mode != DAMPING_NONE
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def force(model, p, r, x, v, f):
     """Add the damping force (N) on ring ``r`` to ``f``."""
     damping_force(x, v, model.node_mass[r], model.damping, model.damping_mode, f)
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def jacobian(model, p, r, x, v, coef_x, coef_v, ws, rank):
     """Add ``coef_x dF/dx + coef_v dF/dv`` to ``ws.band`` and its low-rank part to ``ws.u``, ``ws.w``."""
     return damping_jacobian(
@@ -47,13 +46,13 @@ def jacobian(model, p, r, x, v, coef_x, coef_v, ws, rank):
     )  # fmt: skip
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def energy(model, p, r, x, v):
     """Dissipative: no potential."""
     return 0.0
 
 
-@njit(cache=True)
+@kernel
 def damping_force(x, v, node_mass, damping, mode, f):
     """Add ``F_i = -c m (u_i - u_rigid,i)``; ``u_rigid = V + omega e_z x r_i`` (mode rigid) or ``V``
     (mode centre of mass, the paper's, which also damps spin). ``c`` in 1/s."""
@@ -68,7 +67,7 @@ def damping_force(x, v, node_mass, damping, mode, f):
         f[i, 1] -= cm * (v[i, 1] - vy - omega * rx)
 
 
-@njit(cache=True)
+@kernel
 def damping_jacobian(x, v, node_mass, damping, mode, coef_x, coef_v, band, pos, u, w, rank):
     """Add ``coef_x dF/dx + coef_v dF/dv`` of the damping force.
 

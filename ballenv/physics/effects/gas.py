@@ -10,10 +10,9 @@ in O(N) by the Woodbury identity). On for rings with ``Ring.pressure`` set.
 
 import math
 
-from numba import njit
-
 from ..cyclic import next_node, prev_node
 from ..geometry import polygon_area
+from ..jit import kernel
 from ..linalg import band_add_block
 
 NAME = "pressure"
@@ -27,12 +26,12 @@ def enabled(scene):
     return any(r.pressure is not None for r in scene.rings)
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def on(model, p, r):
     return model.pressurised[r]
 
 
-@njit(cache=True)
+@kernel
 def ring_pressure(model, r, x):
     """Gauge pressure (Pa) of ring ``r`` with nodes ``x``; 0 for a ring without gas."""
     if not model.pressurised[r]:
@@ -42,13 +41,13 @@ def ring_pressure(model, r, x):
     )
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def force(model, p, r, x, v, f):
     """Add ``F_i = p b dA/dx_i`` (N) of ring ``r`` to ``f``."""
     pressure_force(x, ring_pressure(model, r, x), model.width[r], f)
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def jacobian(model, p, r, x, v, coef_x, coef_v, ws, rank):
     """Add ``coef_x dF/dx`` to ``ws.band`` and its rank-one part to ``ws.u``, ``ws.w``."""
     area = polygon_area(x)
@@ -57,7 +56,7 @@ def jacobian(model, p, r, x, v, coef_x, coef_v, ws, rank):
     return pressure_jacobian(x, pressure, slope, model.width[r], coef_x, ws.band, ws.pos, ws.u, ws.w, rank)
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def energy(model, p, r, x, v):
     """Potential (J) of ring ``r``'s gas (see :func:`gas_energy`)."""
     return gas_energy(
@@ -66,7 +65,7 @@ def energy(model, p, r, x, v):
     )  # fmt: skip
 
 
-@njit(cache=True)
+@kernel
 def gas_pressure(area, gas_constant, gas_exponent, atmospheric_pressure):
     """Gauge pressure (Pa) from the gas law ``(p + p_atm) A^k = C``; ``C`` in Pa m^(2k). NaN for a
     polygon turned inside out (``A <= 0``: no gas state; the Newton iterate is then taken back or
@@ -76,7 +75,7 @@ def gas_pressure(area, gas_constant, gas_exponent, atmospheric_pressure):
     return gas_constant / area**gas_exponent - atmospheric_pressure
 
 
-@njit(cache=True)
+@kernel
 def gas_pressure_slope(area, gas_constant, gas_exponent):
     """``dp/dA = -k (p + p_atm) / A`` (Pa/m^2); NaN for ``A <= 0``."""
     if not area > 0.0:
@@ -84,7 +83,7 @@ def gas_pressure_slope(area, gas_constant, gas_exponent):
     return -gas_exponent * gas_constant / area ** (gas_exponent + 1.0)
 
 
-@njit(cache=True)
+@kernel
 def gas_energy(area, gas_constant, gas_exponent, atmospheric_pressure, width):
     """Potential (J) of the gas, ``U = -b int (p + p_atm - p_atm) dA``; ``F = -dU/dx = b p dA/dx``.
 
@@ -100,7 +99,7 @@ def gas_energy(area, gas_constant, gas_exponent, atmospheric_pressure, width):
     )
 
 
-@njit(cache=True)
+@kernel
 def pressure_force(x, pressure, width, f):
     """Add ``F_i = p b dA/dx_i`` (the line load ``p b`` along each edge, half to each end node)."""
     n = x.shape[0]
@@ -112,7 +111,7 @@ def pressure_force(x, pressure, width, f):
         f[i, 1] += s * (x[p, 0] - x[q, 0])
 
 
-@njit(cache=True)
+@kernel
 def pressure_jacobian(x, pressure, pressure_slope, width, coef, band, pos, u, w, rank):
     """Add ``coef dF/dx = coef b (p hess A + dp/dA grad A grad A^T)``; the second term is rank one."""
     n = x.shape[0]

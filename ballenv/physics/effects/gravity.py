@@ -4,7 +4,7 @@
 ``Scene.gravity`` is not 0.
 """
 
-from numba import njit
+from ..jit import kernel
 
 NAME = "gravity"
 ENERGY_PART = "gravity"
@@ -17,30 +17,30 @@ def enabled(scene):
     return any(g != 0.0 for g in scene.gravity_vector)
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def on(model, p, r):
     return model.use_gravity
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def force(model, p, r, x, v, f):
     """Add ``m g`` (N) to every node of ring ``r``."""
     gravity_force(model.node_mass[r], model.gravity, f)
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def jacobian(model, p, r, x, v, coef_x, coef_v, ws, rank):
     """A constant force: nothing to add."""
     return rank
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def energy(model, p, r, x, v):
     """Potential (J) of ring ``r`` in the field."""
     return gravity_energy(x, model.node_mass[r], model.gravity)
 
 
-@njit(cache=True)
+@kernel
 def gravity_force(node_mass, gravity, f):
     """Add ``F_i = m g`` with ``gravity`` the acceleration vector (m/s^2)."""
     for i in range(f.shape[0]):
@@ -48,7 +48,7 @@ def gravity_force(node_mass, gravity, f):
         f[i, 1] += node_mass * gravity[1]
 
 
-@njit(cache=True)
+@kernel
 def gravity_energy(x, node_mass, gravity):
     """Potential (J) ``-sum_i m g . x_i``."""
     e = 0.0

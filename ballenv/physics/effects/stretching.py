@@ -10,9 +10,8 @@ exact. Always on.
 
 import math
 
-from numba import njit
-
 from ..cyclic import next_node
+from ..jit import kernel
 from ..linalg import band_add_block
 
 NAME = "stretching"
@@ -26,31 +25,31 @@ def enabled(scene):
     return True
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def on(model, p, r):
     return True
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def force(model, p, r, x, v, f):
     """Add the stretching forces (N) on ring ``r`` to ``f``."""
     stretch_force(x, model.rest_len[r], model.ea[r], f)
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def jacobian(model, p, r, x, v, coef_x, coef_v, ws, rank):
     """Add ``coef_x dF/dx`` to ``ws.band`` (no velocity dependence, no low-rank part)."""
     stretch_jacobian(x, model.rest_len[r], model.ea[r], coef_x, ws.band, ws.pos)
     return rank
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def energy(model, p, r, x, v):
     """Stretching energy (J) of ring ``r``."""
     return stretch_energy(x, model.rest_len[r], model.ea[r])
 
 
-@njit(cache=True)
+@kernel
 def _edge(x, i, n, rest_len):
     """Edge ``(i, i + 1)``: its end node ``j``, vector ``(dx, dy)`` and length (m), and strain
     ``eps = |e| / l0 - 1``."""
@@ -61,7 +60,7 @@ def _edge(x, i, n, rest_len):
     return j, dx, dy, length, length / rest_len - 1.0
 
 
-@njit(cache=True)
+@kernel
 def stretch_energy(x, rest_len, ea):
     """Stretching energy (J) of the ring."""
     n = x.shape[0]
@@ -72,7 +71,7 @@ def stretch_energy(x, rest_len, ea):
     return e
 
 
-@njit(cache=True)
+@kernel
 def stretch_force(x, rest_len, ea, f):
     """Add the stretching forces (N) to ``f`` (N, 2)."""
     n = x.shape[0]
@@ -85,7 +84,7 @@ def stretch_force(x, rest_len, ea, f):
         f[j, 1] -= s * dy
 
 
-@njit(cache=True)
+@kernel
 def stretch_jacobian(x, rest_len, ea, coef, band, pos):
     """Add ``coef * dF_s/dx`` to ``band``.
 

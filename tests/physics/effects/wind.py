@@ -6,7 +6,7 @@ Every node of a ring gets the same force ``w`` (N), the ring's own parameters ``
 where this example takes its values from; a built-in force would read a Scene or Ring field.
 """
 
-from numba import njit
+from ballenv.physics.jit import kernel
 
 NAME = "wind"
 ENERGY_PART = "wind"
@@ -23,24 +23,24 @@ def parameters(scene, r):
     return LOAD.get(r, (0.0, 0.0))
 
 
-@njit(cache=True)
+@kernel
 def on(model, p, r):
     return p[0] != 0.0 or p[1] != 0.0
 
 
-@njit(cache=True)
+@kernel
 def force(model, p, r, x, v, f):
     for i in range(x.shape[0]):
         f[i, 0] += p[0]
         f[i, 1] += p[1]
 
 
-@njit(cache=True)
+@kernel
 def jacobian(model, p, r, x, v, coef_x, coef_v, ws, rank):
     return rank
 
 
-@njit(cache=True)
+@kernel
 def energy(model, p, r, x, v):
     e = 0.0
     for i in range(x.shape[0]):
