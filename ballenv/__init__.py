@@ -6,7 +6,7 @@ spawned subprocesses), ``gym.make("ballenv:InflatedBall-v1")``. Without gymnasiu
 simulator, ``ballenv.physics``, still imports (it needs only numpy, numba and tqdm).
 """
 
-__version__ = "0.1.0"
+__version__ = "0.1.0"  # the package metadata reads it (pyproject.toml: dynamic version)
 
 try:
     import gymnasium  # noqa: F401

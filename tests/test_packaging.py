@@ -1,6 +1,7 @@
 """The distribution: the wheel built from this source tree holds the licence, both packages with
 their data files, and console scripts that resolve to callables."""
 
+import importlib.metadata
 import pathlib
 import shutil
 import subprocess
@@ -48,3 +49,13 @@ def test_the_wheel_carries_the_mit_licence(wheel):
     licence = dist_info(wheel, "licenses/LICENSE")
     assert licence.startswith("MIT License") and "Copyright (c)" in licence
     assert licence == (ROOT / "LICENSE").read_text()
+
+
+def test_the_version_is_written_once_and_the_metadata_reads_it(wheel):
+    import ballenv
+
+    metadata = dist_info(wheel, "METADATA")
+    assert f"Version: {ballenv.__version__}" in metadata.splitlines()
+    assert pathlib.Path(wheel.filename).name.startswith(f"ballenv-{ballenv.__version__}-")
+    # the installed distribution (here the editable install of the development environment)
+    assert importlib.metadata.version("ballenv") == ballenv.__version__
