@@ -59,3 +59,7 @@ def test_the_version_is_written_once_and_the_metadata_reads_it(wheel):
     assert pathlib.Path(wheel.filename).name.startswith(f"ballenv-{ballenv.__version__}-")
     # the installed distribution (here the editable install of the development environment)
     assert importlib.metadata.version("ballenv") == ballenv.__version__
+
+
+def test_the_wheel_marks_ballenv_as_typed(wheel):
+    assert "ballenv/py.typed" in wheel.namelist()
