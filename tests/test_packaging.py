@@ -1,6 +1,7 @@
 """The distribution: the wheel built from this source tree holds the licence, both packages with
 their data files, and console scripts that resolve to callables."""
 
+import importlib
 import importlib.metadata
 import pathlib
 import shutil
@@ -63,3 +64,37 @@ def test_the_version_is_written_once_and_the_metadata_reads_it(wheel):
 
 def test_the_wheel_marks_ballenv_as_typed(wheel):
     assert "ballenv/py.typed" in wheel.namelist()
+
+
+def test_the_wheel_holds_every_module_and_the_hyperparameter_files(wheel):
+    names = set(wheel.namelist())
+    for package in ("ballenv", "agents"):
+        for path in (ROOT / package).rglob("*"):
+            if path.suffix in (".py", ".yml"):
+                assert path.relative_to(ROOT).as_posix() in names
+    for algo in ("ppo", "sac", "heuristic"):
+        assert f"agents/hyperparams/{algo}.yml" in names
+
+
+def console_scripts(wheel):
+    """name -> "module:function" of the wheel's console scripts."""
+    section, scripts = None, {}
+    for line in dist_info(wheel, "entry_points.txt").splitlines():
+        if line.startswith("["):
+            section = line.strip("[]")
+        elif section == "console_scripts" and "=" in line:
+            name, target = (part.strip() for part in line.split("=", 1))
+            scripts[name] = target
+    return scripts
+
+
+def test_the_console_scripts_resolve_and_answer_help(wheel, capsys):
+    scripts = console_scripts(wheel)
+    assert set(scripts) == {"ballenv-train", "ballenv-evaluate", "ballenv-scenes", "ballenv-viewer"}
+    for name, target in scripts.items():
+        module, function = target.split(":")
+        main = getattr(importlib.import_module(module), function)
+        with pytest.raises(SystemExit) as stop:
+            main(["--help"])
+        assert stop.value.code == 0, name
+        assert capsys.readouterr().out.startswith("usage:"), name
