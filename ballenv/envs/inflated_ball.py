@@ -116,7 +116,7 @@ class InflatedBallEnv(Env, EzPickle):
     | arena_half_width            | float | 3.0            | (m) |
     | arena_height                | float | 5.0            | (m) |
     | rest_height                 | float | 0.01           | the ball is at rest when it could rise no more (m) |
-    | render_mode                 | str   | None           | "human" or "rgb_array" |
+    | render_mode                 | str   | None           | "human" or "rgb_array"; one frame per control step, ``metadata["render_fps"]`` = control_frequency (real time) |
 
     ## Version History
     - v1: numerics of the simulator changed (same physics, different numbers): the fidelity presets
@@ -132,7 +132,7 @@ class InflatedBallEnv(Env, EzPickle):
     - v0: initial release.
     """
 
-    metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 50}
+    metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 100.0}  # control_frequency
 
     def __init__(self, render_mode=None, **kwargs):
         EzPickle.__init__(self, render_mode=render_mode, **kwargs)
@@ -150,7 +150,8 @@ class InflatedBallEnv(Env, EzPickle):
         self._observation_structure = observation_structure(self.config.n_nodes, self.config.mode)
         self._actions = np.zeros(1)
         self._renderer = None
-        self.metadata = {**self.metadata, "render_fps": int(round(min(self.config.control_frequency, 50.0)))}
+        # one frame per control step: videos (RecordVideo) and the window play in real time
+        self.metadata = {**self.metadata, "render_fps": self.config.control_frequency}
 
     @property
     def observation_structure(self):

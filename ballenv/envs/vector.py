@@ -39,7 +39,7 @@ class InflatedBallVectorEnv(VectorEnv):
 
     metadata = {
         "render_modes": ["rgb_array"],
-        "render_fps": 50,
+        "render_fps": 100.0,  # control_frequency (set per instance)
         "autoreset_mode": AutoresetMode.NEXT_STEP,
     }
 
@@ -90,6 +90,7 @@ class InflatedBallVectorEnv(VectorEnv):
         self._autoreset = np.zeros(num_envs, dtype=np.bool_)
         self._actions = np.zeros(num_envs)
         self._renderer = None
+        self.metadata = {**self.metadata, "render_fps": self.config.control_frequency}
 
     @property
     def observation_structure(self):

@@ -8,9 +8,11 @@ import gymnasium as gym
 import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
+from gymnasium.wrappers import RenderCollection
 
 import ballenv  # noqa: F401  (registers the env)
 from ballenv.envs.inflated_ball import InflatedBallEnv
+from ballenv.envs.vector import InflatedBallVectorEnv
 
 MODES = ("pressure", "paddle")
 
@@ -136,6 +138,25 @@ def test_rgb_array_render_is_an_image_and_opens_no_window():
     assert frame.dtype == np.uint8 and frame.ndim == 3 and frame.shape[2] == 3
     assert len(np.unique(frame.reshape(-1, 3), axis=0)) > 3  # ring, ground, text drawn
     assert not pygame.display.get_init()
+
+
+@pytest.mark.parametrize("frequency", [20.0, 50.0, 100.0, 250.0])
+def test_videos_play_in_real_time_one_frame_per_control_step(frequency):
+    # RecordVideo writes the frames it collects at metadata["render_fps"]; RenderCollection collects
+    # them the same way (one per reset and step) without a video encoder
+    env = RenderCollection(gym.make("InflatedBall-v1", control_frequency=frequency, render_mode="rgb_array"))
+    assert env.metadata["render_fps"] == frequency
+    env.reset(seed=0)
+    steps = 12
+    for _ in range(steps):
+        *_, info = env.step(np.zeros(1, dtype=np.float32))
+    frames = env.render()
+    assert len(frames) == steps + 1
+    frames_per_simulated_second = steps / info["time"]
+    assert frames_per_simulated_second == pytest.approx(env.metadata["render_fps"], rel=1e-12)
+    vector = InflatedBallVectorEnv(num_envs=1, num_threads=1, control_frequency=frequency)
+    assert vector.metadata["render_fps"] == frequency
+    vector.close()
 
 
 def test_pressure_actions_move_the_energy_budget_and_reset_starts_a_new_one():
