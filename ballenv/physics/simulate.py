@@ -11,7 +11,9 @@ def simulate(scene, t_end, x0=None, v0=None, output_dt=None, progress=False):
         scene: the :class:`Scene`.
         t_end: end time (s), in (0, 1e6].
         x0, v0: optional initial node positions (m) and velocities (m/s), shape (n_rings, n_nodes, 2)
-            (or (n_nodes, 2) for one ring); default: the rings' circles and rigid motions.
+            (or (n_nodes, 2) for one ring); default: the rings' circles and rigid motions. Each ring
+            of ``x0`` must be a simple polygon with its nodes counter-clockwise and no two
+            neighbours at the same place (ValueError otherwise, before anything is compiled).
         output_dt: record interval (s); None records every accepted step.
         progress: show a progress bar (tqdm) over simulated time.
 

@@ -18,9 +18,10 @@ import numpy as np
 from . import ring as ring_geometry
 from .actuation import apply_impulse, set_rest_pressure
 from .assembly import ENERGY_PARTS, ring_energy
-from .collision import find_contacts
+from .collision import find_contacts, self_intersects
 from .effects import EFFECTS, scene_effects
 from .events import event_list
+from .geometry import polygon_area
 from .integrator import build_solver
 from .layout import (
     CLOCK_COLLISION_GAIN,
@@ -56,6 +57,7 @@ from .stepper import advance, initial_state_values, record
 
 EVENT_ROWS_PER_RING = 64  # starting room of the event buffer (it grows)
 RECORDS = 1024  # starting room of the recording when every step is recorded (it grows)
+SHORTEST_EDGE = 1e-6  # shortest edge of a starting ring (fraction of its rest edge length)
 
 
 class SimulationError(RuntimeError):
@@ -194,7 +196,8 @@ class Simulation:
 
     ``advance(t)`` steps to time ``t`` (s); ``set_rest_pressure``, ``apply_impulse`` actuate between
     advances; ``trajectory()`` and ``stats()`` read what was recorded. Raises ValueError on invalid
-    ``x0``/``v0`` (shape, non-finite, below a ground, rings inside each other).
+    ``x0``/``v0`` (shape, non-finite, coincident neighbouring nodes, nodes running clockwise, a wall
+    crossing itself, below a ground, rings inside each other).
     """
 
     def __init__(
@@ -220,6 +223,8 @@ class Simulation:
         x_init, v_init = initial_state(scene)
         self.state.x[:] = _check_state(caller, "x0", x0, shape) if x0 is not None else x_init
         self.state.v[:] = _check_state(caller, "v0", v0, shape) if v0 is not None else v_init
+        if x0 is not None:
+            _check_ring_shapes(caller, scene, self.state.x)
         _check_above_grounds(caller, self.model.grounds, self.state.x)
         if self.model.collide:
             _check_apart(caller, self.model, self.state.x, self.ws)
@@ -399,6 +404,34 @@ def _check_state(caller, name, value, shape):
     if not np.all(np.isfinite(arr)):
         raise ValueError(f"{caller}.{name} contains NaN or inf: must be finite")
     return arr.copy()
+
+
+def _check_ring_shapes(caller, scene, x):
+    """Refuse starting node positions ``x`` (R, N, 2) m on which the wall's forces are undefined or
+    the step cannot start: neighbouring nodes (almost) at the same place, nodes running clockwise
+    (the gas would pull the wall inward), or, when the scene rejects such states, a self-crossing
+    wall."""
+    for r, (ring, nodes) in enumerate(zip(scene.rings, x, strict=True)):
+        edges = np.linalg.norm(np.roll(nodes, -1, axis=0) - nodes, axis=1)
+        shortest = SHORTEST_EDGE * ring_geometry.rest_edge_length(ring.radius, ring.n_nodes)
+        i = int(np.argmin(edges))
+        if edges[i] <= shortest:
+            raise ValueError(
+                f"{caller}.x0: nodes {i} and {(i + 1) % len(nodes)} of ring {r} are {edges[i]:.3g} m apart: "
+                f"neighbouring nodes must be more than {shortest:.3g} m apart ({SHORTEST_EDGE:g} of the "
+                "rest edge length)"
+            )
+        area = polygon_area(nodes)
+        if area <= 0.0:
+            raise ValueError(
+                f"{caller}.x0: the nodes of ring {r} run clockwise (signed area {area:.3g} m^2): they must "
+                "be in counter-clockwise order, as on the ring's circle (reverse their order)"
+            )
+        if scene.self_intersection == "reject" and self_intersects(nodes):
+            raise ValueError(
+                f"{caller}.x0: the wall of ring {r} crosses itself: it must be a simple "
+                "polygon (Scene.self_intersection = 'reject' refuses every self-crossing state)"
+            )
 
 
 def _grown(rec, counters):

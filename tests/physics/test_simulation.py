@@ -5,6 +5,7 @@ import pytest
 
 from ballenv.physics import Ground, Ring, Scene, Simulation, simulate
 from ballenv.physics.layout import ENERGY_BUDGET, ENERGY_TOTAL
+from ballenv.physics.simulation import initial_state
 
 
 def _scene(**kw):
@@ -97,3 +98,40 @@ def test_invalid_settings_name_the_driver():
         Simulation(_scene(), output_dt=-1.0)
     with pytest.raises(ValueError, match=r"Simulation\.x0"):
         Simulation(_scene(), x0=np.zeros((3, 2)))
+
+
+def _coincident(x):
+    x[0, 5] = x[0, 4]
+    return x
+
+
+def _swapped(x):
+    x[0, [3, 4]] = x[0, [4, 3]]  # edges 2-4 and 3-5 cross
+    return x
+
+
+@pytest.mark.parametrize(
+    "start, message",
+    [
+        (np.zeros_like, r"simulate\.x0: nodes 0 and 1 of ring 0 are 0 m apart: neighbouring nodes must be"),
+        (
+            _coincident,
+            r"simulate\.x0: nodes 4 and 5 of ring 0 are 0 m apart: .* more than 3\.9e-08 m apart",
+        ),
+        (lambda x: x[:, ::-1], r"simulate\.x0: the nodes of ring 0 run clockwise .* counter-clockwise"),
+        (_swapped, r"simulate\.x0: the wall of ring 0 crosses itself: it must be a simple polygon"),
+    ],
+)
+def test_a_start_shape_the_wall_cannot_take_is_refused_before_any_step(start, message):
+    # these died in the compiled code (ZeroDivisionError) or as "Newton did not converge, lower dt"
+    scene = _scene()
+    x, _ = initial_state(scene)
+    with pytest.raises(ValueError, match=message):
+        simulate(scene, 0.01, x0=start(x.copy()))
+
+
+def test_a_self_crossing_start_is_accepted_when_the_scene_ignores_self_crossing():
+    scene = _scene(self_intersection="ignore")
+    x, _ = initial_state(scene)
+    sim = Simulation(scene, x0=_swapped(x.copy()))
+    assert np.array_equal(sim.state.x, _swapped(x.copy()))
