@@ -5,6 +5,7 @@ import math
 from dataclasses import dataclass, fields
 
 import numpy as np
+from gymnasium.error import ResetNeeded
 
 from ..physics import Ground, Ring, Scene
 from ..physics.layout import STATUS_IMPULSE_AT_DT_MIN, STATUS_STEP_TOO_SMALL
@@ -190,6 +191,16 @@ def parse_actions(actions, count, what):
         f"InflatedBall-v1 {what} = {actions!r} is invalid: must be {count} finite real number"
         f"{'s' if count > 1 else ''} (shape {shape}; values outside [-1, 1] are clipped)"
     )
+
+
+def check_reset(has_reset, call):
+    """Raise gymnasium's ``ResetNeeded`` if ``call`` ("step", "render", ...) comes before the first
+    reset: until then the ball has no state (its arrays are zeros)."""
+    if not has_reset:
+        raise ResetNeeded(
+            f"InflatedBall-v1 {call}() was called before reset(): call reset() first, which places "
+            "the ball and draws the episode's target"
+        )
 
 
 def draw_reset(config, rng):

@@ -5,7 +5,7 @@ from gymnasium import Env, spaces
 from gymnasium.utils import EzPickle
 
 from .batch import END_REASONS, REWARD, REWARD_TERMS, REWARD_TOTAL, BallBatch, observation_structure
-from .config import BallEnvConfig, draw_reset, failure_message, parse_actions
+from .config import BallEnvConfig, check_reset, draw_reset, failure_message, parse_actions
 
 
 class InflatedBallEnv(Env, EzPickle):
@@ -150,6 +150,7 @@ class InflatedBallEnv(Env, EzPickle):
         self._observation_structure = observation_structure(self.config.n_nodes, self.config.mode)
         self._actions = np.zeros(1)
         self._renderer = None
+        self._has_reset = False
         # one frame per control step: videos (RecordVideo) and the window play in real time
         self.metadata = {**self.metadata, "render_fps": self.config.control_frequency}
 
@@ -167,12 +168,14 @@ class InflatedBallEnv(Env, EzPickle):
         super().reset(seed=seed)
         centre, velocity, phase, target = draw_reset(self.config, self.np_random)
         self._batch.reset(0, centre, velocity, phase, target, self.config.initial_pressure)
+        self._has_reset = True
         if self.render_mode == "human":
             self.render()
         info = {"target_height": float(target), "time": 0.0}
         return self._batch.obs[0].copy(), info
 
     def step(self, action):
+        check_reset(self._has_reset, "step")
         a = parse_actions(action, 1, "step action")
         self._actions[0] = min(1.0, max(-1.0, a[0]))
         batch = self._batch
@@ -203,6 +206,7 @@ class InflatedBallEnv(Env, EzPickle):
     def render(self):
         if self.render_mode is None:
             return None
+        check_reset(self._has_reset, "render")
         if self._renderer is None:
             from ..render import BallRenderer
 

@@ -23,7 +23,7 @@ from .batch import (
     BallBatch,
     observation_structure,
 )
-from .config import BallEnvConfig, draw_reset, failure_message, parse_actions
+from .config import BallEnvConfig, check_reset, draw_reset, failure_message, parse_actions
 from .inflated_ball import InflatedBallEnv
 
 DEFAULT_MAX_EPISODE_STEPS = 1000
@@ -90,6 +90,7 @@ class InflatedBallVectorEnv(VectorEnv):
         self._autoreset = np.zeros(num_envs, dtype=np.bool_)
         self._actions = np.zeros(num_envs)
         self._renderer = None
+        self._has_reset = False
         self.metadata = {**self.metadata, "render_fps": self.config.control_frequency}
 
     @property
@@ -114,6 +115,7 @@ class InflatedBallVectorEnv(VectorEnv):
             self._rngs[i], _ = seeding.np_random(s)
             self._reset_env(i)
         self._autoreset[:] = False
+        self._has_reset = True
         info = {"target_height": self._batch.task.target.copy(), "time": np.zeros(self.num_envs)}
         return self._batch.obs.copy(), info
 
@@ -122,6 +124,7 @@ class InflatedBallVectorEnv(VectorEnv):
         self._batch.reset(i, centre, velocity, phase, target, self.config.initial_pressure)
 
     def step(self, actions):
+        check_reset(self._has_reset, "vector step")
         a = parse_actions(actions, self.num_envs, "vector step actions")
         np.clip(a, -1.0, 1.0, out=self._actions)
         resetting = self._autoreset.copy()
@@ -160,6 +163,7 @@ class InflatedBallVectorEnv(VectorEnv):
     def render(self):
         if self.render_mode is None:
             return None
+        check_reset(self._has_reset, "vector render")
         if self._renderer is None:
             from ..render import BallRenderer
 

@@ -7,6 +7,7 @@ import warnings
 import gymnasium as gym
 import numpy as np
 import pytest
+from gymnasium.error import ResetNeeded
 from gymnasium.utils.env_checker import check_env
 from gymnasium.wrappers import RenderCollection
 
@@ -117,6 +118,22 @@ def test_step_returns_new_arrays_and_python_scalars():
 def test_invalid_arguments_raise_value_error_naming_the_field(kwargs, field):
     with pytest.raises(ValueError, match=field):
         InflatedBallEnv(**kwargs)
+
+
+def test_step_or_render_before_reset_asks_for_a_reset():
+    # the unwrapped env (gym.make's OrderEnforcing wrapper says the same); was a ZeroDivisionError
+    env = InflatedBallEnv(render_mode="rgb_array")
+    with pytest.raises(ResetNeeded, match=r"InflatedBall-v1 step\(\) was called before reset\(\)"):
+        env.step(np.zeros(1, dtype=np.float32))
+    with pytest.raises(ResetNeeded, match=r"render\(\) was called before reset\(\)"):
+        env.render()
+    env.reset(seed=0)
+    obs, reward, *_ = env.step(np.zeros(1, dtype=np.float32))
+    assert np.all(np.isfinite(obs)) and 0.0 <= reward <= 1.0
+    assert env.render().shape == (480, 480, 3)
+    clone = pickle.loads(pickle.dumps(env))  # a fresh env: it needs its own reset
+    with pytest.raises(ResetNeeded):
+        clone.step(np.zeros(1, dtype=np.float32))
 
 
 def test_invalid_action_raises_and_out_of_range_actions_are_clipped():

@@ -3,6 +3,7 @@
 import gymnasium as gym
 import numpy as np
 import pytest
+from gymnasium.error import ResetNeeded
 
 import ballenv  # noqa: F401  (registers the env)
 from ballenv.envs.vector import InflatedBallVectorEnv
@@ -122,3 +123,15 @@ def test_vector_env_spaces_and_errors():
     frames.reset(seed=0)
     images = frames.render()
     assert len(images) == 2 and images[0].dtype == np.uint8
+
+
+def test_vector_step_or_render_before_reset_asks_for_a_reset():
+    venv = InflatedBallVectorEnv(num_envs=2, num_threads=1, render_mode="rgb_array")
+    with pytest.raises(ResetNeeded, match=r"vector step\(\) was called before reset\(\)"):
+        venv.step(np.zeros((2, 1), dtype=np.float32))
+    with pytest.raises(ResetNeeded, match=r"vector render\(\) was called before reset\(\)"):
+        venv.render()
+    venv.reset(seed=0)
+    obs, reward, *_ = venv.step(np.zeros((2, 1), dtype=np.float32))
+    assert np.all(np.isfinite(obs)) and np.all((reward >= 0.0) & (reward <= 1.0))
+    venv.close()
