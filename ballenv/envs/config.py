@@ -10,7 +10,7 @@ from gymnasium.error import ResetNeeded
 from ..physics import Ground, Ring, Scene
 from ..physics.layout import STATUS_IMPULSE_AT_DT_MIN, STATUS_STEP_TOO_SMALL
 from ..physics.presets import FIDELITY_PRESETS, with_fidelity
-from ..physics.ring import inflation_ratio_of
+from ..physics.ring import burst_pressure, inflation_ratio_of
 from ..physics.scene import check_choice, check_real
 from . import observation
 from .batch import END_FAILURE, MODE_PADDLE, MODE_PRESSURE
@@ -78,11 +78,12 @@ class BallEnvConfig:
         s(self, "gravity", check_real(o, "gravity", self.gravity, 0.0, 1000.0, "m/s^2", low_open=True))
         s(self, "arena_half_width", check_real(o, "arena_half_width", self.arena_half_width, 0.1, 1e4, "m"))
         s(self, "arena_height", check_real(o, "arena_height", self.arena_height, 0.1, 1e4, "m"))
-        # ring material: Ring validates it and the largest pressure (the wall's 100 % strain bound)
+        _check_wall(self)
         s(self, "pressure_range", _range(o, "pressure_range", self.pressure_range, 0.0, 1e8, "Pa"))
+        _check_wall_holds(self, "pressure_range", self.pressure_range[1])
         ring = self.ring(self.pressure_range[1])
         s(self, "initial_pressure", check_real(o, "initial_pressure", self.initial_pressure, 0.0, 1e8, "Pa"))
-        self.ring(self.initial_pressure)
+        _check_wall_holds(self, "initial_pressure", self.initial_pressure)
         if self.action_mode == "pressure" and not (
             self.pressure_range[0] <= self.initial_pressure <= self.pressure_range[1]
         ):
@@ -162,6 +163,28 @@ class BallEnvConfig:
                 f"InflatedBall-v1 got unknown keyword arguments {unknown}; known: {sorted(known)}"
             )
         return cls(**kwargs)
+
+
+def _check_wall(config):
+    """The ring's own checks of the wall's keywords (``radius``, ``youngs_modulus``, ``thickness``,
+    ``width``, ``density``: the same names on the env and on :class:`Ring`), reported as the env's."""
+    try:
+        config.ring(None)
+    except ValueError as err:
+        raise ValueError(str(err).replace("Ring.", "InflatedBall-v1.", 1)) from None
+
+
+def _check_wall_holds(config, name, pressure):
+    """ValueError naming the keyword ``name`` if ``pressure`` (Pa, gauge, at rest) bursts the ball:
+    above the pressure its wall holds stretched by 100 % (``ring.burst_pressure``)."""
+    held = burst_pressure(config.radius, config.n_nodes, config.youngs_modulus, config.thickness)
+    if pressure > held:
+        raise ValueError(
+            f"InflatedBall-v1.{name} = {getattr(config, name)!r} is out of range: {pressure:g} Pa must be "
+            f"at most {held:.6g} Pa, the gauge pressure that stretches the wall (radius = {config.radius:g} "
+            f"m, youngs_modulus = {config.youngs_modulus:g} Pa, thickness = {config.thickness:g} m) by "
+            f"100 %; beyond, the ball bursts: lower {name} or stiffen the wall (youngs_modulus, thickness)"
+        )
 
 
 def _range(owner, name, value, low, high, unit):

@@ -65,6 +65,13 @@ def total_mass(ring):
     return ring.n_nodes * node_mass(ring)
 
 
+def burst_pressure(radius, n_nodes, youngs_modulus, thickness):
+    """The largest gauge pressure (Pa) a ring holds at rest: ``E h / (2 R cos(pi / N))``, where
+    ``q = 1/2`` and the inflated wall is stretched by 100 % (``q / (1 - q)``); ``Ring.pressure``'s
+    upper bound."""
+    return 0.5 * youngs_modulus * thickness / (radius * math.cos(math.pi / n_nodes))
+
+
 @kernel
 def inflation_ratio_of(pressure, width, radius, n_nodes, ea):
     """``q = p b R cos(pi / N) / EA`` (dimensionless) for gauge pressure ``p`` (Pa)."""

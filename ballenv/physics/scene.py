@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 from numbers import Integral, Real
 
 from .effects import scene_effects
+from .ring import burst_pressure
 
 INTEGRATORS = ("backward_euler", "generalized_alpha")
 DAMPING_MODES = ("rigid", "centre_of_mass")
@@ -134,8 +135,7 @@ class Ring:
         s(self, "density", check_real(o, "density", self.density, 0.0, 1e5, "kg/m^3", True))
         if self.pressure is not None:
             # inflated strain q / (1 - q) with q = p R cos(pi/N) / (E h): at most 100 % (q <= 1/2)
-            cos = math.cos(math.pi / self.n_nodes)
-            burst = 0.5 * self.youngs_modulus * self.thickness / (self.radius * cos)
+            burst = burst_pressure(self.radius, self.n_nodes, self.youngs_modulus, self.thickness)
             unit = "Pa (or None); the upper bound inflates the wall by 100 %"
             s(self, "pressure", check_real(o, "pressure", self.pressure, 0.0, min(1e8, burst), unit))
         s(self, "position", check_vector(o, "position", self.position, 1e6, "m"))

@@ -120,6 +120,26 @@ def test_invalid_arguments_raise_value_error_naming_the_field(kwargs, field):
         InflatedBallEnv(**kwargs)
 
 
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"pressure_range": (10e3, 5e6)}, r"pressure_range = \(10000\.0, 5000000\.0\) .* 5e\+06 Pa"),
+        ({"action_mode": "paddle", "initial_pressure": 3e6}, r"initial_pressure = 3000000\.0 .* 3e\+06 Pa"),
+        ({"youngs_modulus": 1e5}, r"pressure_range = \(10000\.0, 50000\.0\) .* 50000 Pa"),
+    ],
+)
+def test_a_pressure_that_bursts_the_ball_is_reported_by_the_env_keyword(kwargs, message):
+    # was "Ring.pressure = ... is out of range", a name the env's user never wrote
+    held = r"83736\.5" if "youngs_modulus" not in kwargs else r"837\.365"
+    with pytest.raises(ValueError, match=rf"^InflatedBall-v1\.{message} must be at most {held} Pa") as err:
+        InflatedBallEnv(**kwargs)
+    assert "bursts" in str(err.value) and "Ring." not in str(err.value)
+    with pytest.raises(
+        ValueError, match=r"^InflatedBall-v1\.thickness = 0\.2 is out of range: .*below radius"
+    ):
+        InflatedBallEnv(thickness=0.2)
+
+
 def test_step_or_render_before_reset_asks_for_a_reset():
     # the unwrapped env (gym.make's OrderEnforcing wrapper says the same); was a ZeroDivisionError
     env = InflatedBallEnv(render_mode="rgb_array")
