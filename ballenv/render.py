@@ -147,11 +147,20 @@ def frame_strip(out, steps=(0, 30, 36, 42, 90), seed=3):
     return out
 
 
-if __name__ == "__main__":
+def main(argv=None):
+    """``python -m ballenv.render [--out PATH]``: write the frame strip (default ``out/env.png``,
+    outside the tracked files; the README's picture is ``--out docs/env.png``)."""
     import argparse
     import os
+    import pathlib
 
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
     parser = argparse.ArgumentParser(description="Write a frame strip of InflatedBall-v1 (both modes).")
-    parser.add_argument("--out", default="docs/env.png", help="PNG file to write")
-    print(frame_strip(parser.parse_args().out))
+    parser.add_argument("--out", default="out/env.png", help="PNG file to write (default out/env.png)")
+    out = pathlib.Path(parser.parse_args(argv).out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    print(frame_strip(out))
+
+
+if __name__ == "__main__":
+    main()
