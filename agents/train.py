@@ -18,11 +18,13 @@ one folder ``{log_dir}/{algo}_{mode}_seed{seed}[_k]`` holding:
 """
 
 import argparse
+import contextlib
 import difflib
 import inspect
 import json
 import pathlib
 import shlex
+import shutil
 import sys
 import time
 from dataclasses import asdict
@@ -87,6 +89,20 @@ def run_folder(log_dir, algo, mode, seed):
         path = base.with_name(f"{base.name}_{k}")
     path.mkdir(parents=True)
     return path
+
+
+@contextlib.contextmanager
+def removed_on_failure(run, made_log_dir):
+    """Remove the run folder ``run`` if the block raises (and its parent, the log folder, if
+    ``made_log_dir`` and it is left empty): a setup that fails leaves no half-made run behind."""
+    try:
+        yield run
+    except BaseException:
+        shutil.rmtree(run, ignore_errors=True)
+        if made_log_dir:
+            with contextlib.suppress(OSError):  # not empty: another run is there
+                run.parent.rmdir()
+        raise
 
 
 def make_envs(
@@ -201,7 +217,8 @@ def main(argv=None):
 def train(args, on_evaluation=None):
     """Train, save and score (unless ``args.final_episodes`` is 0); returns the run folder.
     ``on_evaluation(env steps, mean return)`` sees each periodic evaluation; its False stops the
-    training."""
+    training. If the setup fails (an invalid env keyword, an algorithm that refuses its
+    hyperparameters, ...), the run folder is removed again before the error propagates."""
     import stable_baselines3
     import torch
     from stable_baselines3 import PPO, SAC
@@ -226,6 +243,7 @@ def train(args, on_evaluation=None):
         raise UsageError(str(err)) from None
     gamma = float(algo_kwargs.get("gamma", 0.99))
 
+    made_log_dir = not pathlib.Path(args.log_dir).exists()
     run = run_folder(args.log_dir, args.algo, args.action_mode, args.seed)
     config = {
         "algo": args.algo, "env_id": env_id(args.action_mode), "env_kwargs": env_kwargs, "seed": args.seed,
@@ -236,19 +254,24 @@ def train(args, on_evaluation=None):
         "versions": {"stable_baselines3": str(stable_baselines3.__version__),
                      "torch": str(torch.__version__)},
     }  # fmt: skip
-    (run / "config.yml").write_text(yaml.safe_dump(config, sort_keys=False))
-    (run / "command.txt").write_text(shlex.join([sys.executable, *sys.argv]) + "\n")
-    torch.set_num_threads(1)
-
-    envs = make_envs(
-        env_kwargs, n_envs, args.seed, normalize, gamma, run / "monitor", subproc=args.vec_env == "subproc",
-        wrapper=wrapper,
-    )  # fmt: skip
-    eval_env = make_envs(env_kwargs, 1, args.seed + 1000, normalize, gamma, training=False, wrapper=wrapper)
-    model = cls(
-        config["policy"], envs, seed=args.seed, tensorboard_log=str(run / "tensorboard"), device="cpu",
-        verbose=0, **algo_kwargs,
-    )  # fmt: skip
+    with removed_on_failure(run, made_log_dir), contextlib.ExitStack() as opened:
+        (run / "config.yml").write_text(yaml.safe_dump(config, sort_keys=False))
+        (run / "command.txt").write_text(shlex.join([sys.executable, *sys.argv]) + "\n")
+        torch.set_num_threads(1)
+        envs = make_envs(
+            env_kwargs, n_envs, args.seed, normalize, gamma, run / "monitor",
+            subproc=args.vec_env == "subproc", wrapper=wrapper,
+        )  # fmt: skip
+        opened.callback(envs.close)
+        eval_env = make_envs(
+            env_kwargs, 1, args.seed + 1000, normalize, gamma, training=False, wrapper=wrapper
+        )
+        opened.callback(eval_env.close)
+        model = cls(
+            config["policy"], envs, seed=args.seed, tensorboard_log=str(run / "tensorboard"), device="cpu",
+            verbose=0, **algo_kwargs,
+        )  # fmt: skip
+        opened.pop_all()  # set up: the envs stay open for the training
     start = time.perf_counter()
     model.learn(total_timesteps=total, callback=callbacks(run, eval_env, args, n_envs, total, on_evaluation))
     wall = time.perf_counter() - start

@@ -10,6 +10,7 @@ import yaml
 
 from agents.evaluate import evaluate, main
 from agents.train import main as train_main
+from agents.train import parse_args, train
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 SHORT = {"max_episode_steps": 60}  # gym.make's time limit: short episodes for the tests
@@ -85,3 +86,17 @@ def test_a_mistyped_policy_names_the_choices(capsys):
     with pytest.raises(SystemExit):
         main(["heuristc", "--episodes", "1"])
     assert "policy = 'heuristc' is invalid" in capsys.readouterr().err
+
+
+def test_a_failed_setup_leaves_no_run_folder(tmp_path):
+    runs = tmp_path / "runs"
+    quick = ["--total-timesteps", "64", "--final-episodes", "0", "--log-dir", str(runs)]
+    # an env keyword the env refuses (the default pressure range bursts a 0.1 MPa wall)
+    with pytest.raises(ValueError, match=r"InflatedBall-v1\.pressure_range"):
+        train(parse_args(["--env-kwargs", '{"youngs_modulus": 1e5}', *quick]))
+    assert not runs.exists()
+    # PPO refusing its hyperparameters once the envs are open; an earlier run in runs/ stays
+    (runs / "ppo_pressure_seed0").mkdir(parents=True)
+    with pytest.raises(AssertionError, match="batch_size"):
+        train(parse_args(["--hyperparams", '{"n_steps": 1, "batch_size": 1}', *quick]))
+    assert [p.name for p in runs.iterdir()] == ["ppo_pressure_seed0"]
