@@ -32,11 +32,11 @@ def saved(tmp_path_factory):
 
 
 def chromium():
-    """The chromium binary; missing, the test fails under CI (make test installs it) and skips
+    """The chromium binary; missing, the test fails under CI (.ci/run installs it) and skips
     elsewhere."""
     exe = shutil.which("chromium") or shutil.which("chromium-browser")
     if exe is None:
-        message = "chromium not found: `make test` installs Debian's chromium (apt-get install chromium)"
+        message = "chromium not found: install it (Debian: apt-get install chromium; .ci/run does)"
         if os.environ.get("CI"):
             pytest.fail(message)
         pytest.skip(message)
