@@ -1,28 +1,76 @@
-"""A console notice while numba compiles the simulator (the first run after an install or a code
-change), instead of a silent wait: the compiled kernels are cached on disk (``cache=True``), so
-later runs load them in about a second.
+"""A notice while numba compiles the simulator (the first run after an install or a code change),
+instead of a silent wait: the compiled kernels are cached on disk (``cache=True``), so later runs
+load them in about a second.
 
-:func:`install` registers a listener for numba's compile events; it announces the first
-compilation of a ``ballenv`` kernel on stderr and reports the time when the outermost compile ends.
-Loading from the cache raises no compile event, so a warm run prints nothing.
+:func:`install` registers a listener for numba's compile events; it logs the first compilation of
+a ``ballenv`` kernel and, when the outermost compile ends, the time it took, at INFO on the logger
+``ballenv.physics.compile_notice`` (a child of ``ballenv``). Loading from the cache raises no
+compile event, so a warm run logs nothing.
+
+Where the lines go follows the application's logging: once it has configured logging (a handler
+on the root logger or on ``ballenv``'s), its handlers and levels decide (``logging.basicConfig()``
+alone shows WARNING and above, so not these); while it has configured none, they go to stderr as
+``ballenv: ...`` lines, as ``logging.lastResort`` does for warnings, so that a new user sees why the
+first run waits. ``logging.getLogger("ballenv").setLevel(logging.WARNING)`` silences them either way.
 """
 
+import logging
 import sys
 import time
 
 from numba.core import event
 
+LOGGER = logging.getLogger(__name__)
 NOTICE = (
-    "ballenv: compiling the simulator with numba ({name}); once per install, about a minute "
-    "on two cores; later runs load it from the cache"
+    "compiling the simulator with numba (%s); once per install, about a minute on two cores; "
+    "later runs load it from the cache"
 )
 
 
-class CompileNotice(event.Listener):
-    """Announces outermost compilations of ``ballenv`` kernels on ``stream``."""
+class _Console(logging.StreamHandler):
+    """``ballenv: message`` lines on ``sys.stderr`` as it is at each record (pytest and notebooks
+    replace it)."""
 
-    def __init__(self, stream=None):
-        self.stream = stream
+    def __init__(self):
+        super().__init__()
+        self.setFormatter(logging.Formatter("ballenv: %(message)s"))
+
+    @property
+    def stream(self):
+        return sys.stderr
+
+    @stream.setter
+    def stream(self, value):  # StreamHandler.__init__ sets it; stderr is read at each record
+        pass
+
+
+CONSOLE = _Console()
+
+
+def _ballenv_level():
+    """The level set on this logger or on one of its ``ballenv`` ancestors (the root's not counted);
+    ``logging.NOTSET`` if none."""
+    logger = LOGGER
+    while logger.parent is not None:  # the root logger has no parent
+        if logger.level != logging.NOTSET:
+            return logger.level
+        logger = logger.parent
+    return logging.NOTSET
+
+
+def log_info(message, *args):
+    """Log ``message % args`` at INFO: through the application's logging if it has configured any,
+    else on stderr (unless a level above INFO is set on ``ballenv``'s loggers)."""
+    if LOGGER.hasHandlers():
+        LOGGER.info(message, *args)
+    elif _ballenv_level() <= logging.INFO:
+        CONSOLE.handle(LOGGER.makeRecord(LOGGER.name, logging.INFO, __file__, 0, message, args, None))
+
+
+class CompileNotice(event.Listener):
+    """Logs the outermost compilations of ``ballenv`` kernels (:func:`log_info`)."""
+
+    def __init__(self):
         self.depth = 0
         self.start = 0.0
         self.name = ""
@@ -37,7 +85,7 @@ class CompileNotice(event.Listener):
         if self.depth == 0 and ours:
             self.start = time.perf_counter()
             self.name = name
-            print(NOTICE.format(name=name), file=self.stream or sys.stderr, flush=True)
+            log_info(NOTICE, name)
         if self.depth > 0 or ours:
             self.depth += 1
 
@@ -46,9 +94,7 @@ class CompileNotice(event.Listener):
             return
         self.depth -= 1
         if self.depth == 0:
-            took = time.perf_counter() - self.start
-            stream = self.stream or sys.stderr
-            print(f"ballenv: compiled {self.name} in {took:.0f} s", file=stream, flush=True)
+            log_info("compiled %s in %.0f s", self.name, time.perf_counter() - self.start)
 
 
 _LISTENER = CompileNotice()
