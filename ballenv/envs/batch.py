@@ -206,7 +206,7 @@ def reset_env(
     _clip(obs[e], low, high, out[e])
 
 
-@kernel
+@kernel(inline="always")
 def _rise(me, se, task, e):
     """Height (m) the ball's centre could still rise: free energy (kinetic, elastic and gas above the
     inflated circle at rest) over ``m g``, plus the centre's height above its resting height."""
@@ -225,7 +225,7 @@ def _top(x):
     return top
 
 
-@kernel
+@kernel(inline="always")
 def _paddle_ready(task, e, x, v):
     """Whether the paddle can strike env ``e``'s ball (positions ``x``, velocities ``v``): paddle
     mode, the ball falling (its centre of mass moving down) with its top within ``paddle_reach`` of
@@ -239,7 +239,7 @@ def _paddle_ready(task, e, x, v):
     return falling < 0.0 and abs(_top(x) - task.paddle_height[e]) <= task.paddle_reach
 
 
-@kernel
+@kernel(inline="always")
 def _actuate(me, se, task, e, action, ws, nodes):
     x = se.x[0]
     n = x.shape[0]
@@ -267,7 +267,7 @@ def _actuate(me, se, task, e, action, ws, nodes):
     task.struck[e] = True
 
 
-@kernel
+@kernel(inline="always")
 def _tally(task, e, events, n_events):
     for k in range(n_events):
         kind = int(events[k, EVENT_KIND])
@@ -284,7 +284,7 @@ def _tally(task, e, events, n_events):
             task.last_apex[e] = h
 
 
-@kernel
+@kernel(inline="always")
 def step_env(
     model, solver, ws, state, trial, clocks, counters, records, events, task, e, action, nodes, obs, low,
     high, out,
@@ -367,7 +367,7 @@ def height_reward(error, margin):
     return math.exp(-0.5 * x * x)
 
 
-@kernel
+@kernel(inline="always")
 def _outcome(task, e, row, n):
     """Reward and end of env ``e`` after a control step (see ``InflatedBallEnv``'s Rewards): the
     :func:`height_reward` of the relative error ``|h - h_t| / h_t`` of the :func:`predicted_apex`

@@ -39,7 +39,7 @@ MIN_NEWTON_FRACTION = 1.0 / 32.0  # backtracking halves a correction at most 5 t
 FAILED = -1
 
 
-@kernel
+@kernel(inline="always")
 def residual(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active):
     """The residual of the iterate ``ws.dx`` into ``ws.res`` (and ``x1, v1, a1``); returns
     ``(|r|^2, |r|_inf, force scale, finite)``: ``|r|^2`` is inf when a value is not finite."""
@@ -74,7 +74,7 @@ def residual(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active):
     return merit, worst, scale, True
 
 
-@kernel
+@kernel(inline="always")
 def correction(model, solver, r, x0, h, ws, active):
     """Solve the Newton system at the iterate and apply the correction to ``ws.dx`` (kept in
     ``ws.delta`` for backtracking). Returns ``(ok, settled)``: ok False on a singular system or a
@@ -107,7 +107,7 @@ def correction(model, solver, r, x0, h, ws, active):
     return True, step <= 1e-13 * size
 
 
-@kernel
+@kernel(inline="always")
 def update_contact_set(model, active, x1, reaction):
     """After convergence: free the constrained nodes whose normal reaction ``reaction`` (N) pulls,
     then constrain free nodes below a ground. Returns True if the set changed."""
@@ -121,7 +121,7 @@ def update_contact_set(model, active, x1, reaction):
     return changed
 
 
-@kernel
+@kernel(inline="always")
 def backtrack(ws, lam):
     """Take back the fraction ``lam`` of the last correction ``ws.delta`` from ``ws.dx``."""
     dx = ws.dx

@@ -74,7 +74,7 @@ def initial_acceleration(model, x, v, a, ws):
                 a[r, i, d] = ws.force[i, d] / model.node_mass[r]
 
 
-@kernel
+@kernel(inline="always")
 def collision_kicks(model, state, h, ws):
     """With ring collision or self-contact: the velocities after the collision impulses (found on the
     predicted positions ``x0 + h v0``, ``collision.py``) into ``ws.collision.kicked``, each ring's
@@ -94,7 +94,7 @@ def collision_kicks(model, state, h, ws):
     return True
 
 
-@kernel
+@kernel(inline="always")
 def step_ring(model, solver, r, state, v0, trial, h, ws):
     """Ring ``r``'s trial step and its own acceptance tests: returns its Newton corrections, or
     minus the ``REJECT_`` code (Newton failed, the wall crossed itself, the energy budget)."""
@@ -116,7 +116,7 @@ def step_ring(model, solver, r, state, v0, trial, h, ws):
     return its
 
 
-@kernel
+@kernel(inline="always")
 def contact_impulse(model, solver, r, state, v0, trial, h, ws):
     """Ring ``r``'s contact forces into ``trial.contact_force`` and its contact impulse (N s) for the
     step-size control (see :func:`try_step`)."""
@@ -152,7 +152,7 @@ def contact_impulse(model, solver, r, state, v0, trial, h, ws):
     return math.sqrt(jx * jx + jy * jy)
 
 
-@kernel
+@kernel(inline="always")
 def try_step(model, solver, state, trial, h, ws):
     """One step of every ring from ``state`` into ``trial``.
 
@@ -212,7 +212,7 @@ def record(model, k, t, state, rec):
         rec.pressure[k, r] = ring_pressure(model, r, state.x[r])
 
 
-@kernel
+@kernel(inline="always")
 def copy_state(state, trial):
     """``state`` <- ``trial``, field by field."""
     copy_into(state.x, trial.x)
@@ -223,7 +223,7 @@ def copy_state(state, trial):
     copy_into(state.energy, trial.energy)
 
 
-@kernel
+@kernel(inline="always")
 def step_end(solver, clock, counters, t_end, output_dt):
     """The end of the next step: ``(stop, at_end, at_out, at_grid)``: the time (s) the step from
     ``clock[CLOCK_T]`` with size ``clock[CLOCK_H]`` stops at, shortened to land on the next output
@@ -247,7 +247,7 @@ def step_end(solver, clock, counters, t_end, output_dt):
     return stop, at_end, at_out, at_grid
 
 
-@kernel
+@kernel(inline="always")
 def step_outcome(solver, clock, counters, h, its, ratio):
     """Bookkeeping of a trial step of size ``h`` (s) that returned ``its`` Newton corrections and
     ``ratio`` = impulse_tol over its contact impulse:
@@ -271,7 +271,7 @@ def step_outcome(solver, clock, counters, h, its, ratio):
     return STATUS_DONE
 
 
-@kernel
+@kernel(inline="always")
 def accept(model, solver, ws, state, trial, clock, counters, h, stop, at_grid, ratio, rec):
     """Take the trial step ``state -> trial`` of size ``h`` (s) ending at ``stop`` (s): tallies,
     events, the state, the clock, and the next step size: adaptive, grown by ``min(growth, 1 +
