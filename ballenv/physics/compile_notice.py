@@ -27,26 +27,6 @@ NOTICE = (
 )
 
 
-class _Console(logging.StreamHandler):
-    """``ballenv: message`` lines on ``sys.stderr`` as it is at each record (pytest and notebooks
-    replace it)."""
-
-    def __init__(self):
-        super().__init__()
-        self.setFormatter(logging.Formatter("ballenv: %(message)s"))
-
-    @property
-    def stream(self):
-        return sys.stderr
-
-    @stream.setter
-    def stream(self, value):  # StreamHandler.__init__ sets it; stderr is read at each record
-        pass
-
-
-CONSOLE = _Console()
-
-
 def _ballenv_level():
     """The level set on this logger or on one of its ``ballenv`` ancestors (the root's not counted);
     ``logging.NOTSET`` if none."""
@@ -64,7 +44,7 @@ def log_info(message, *args):
     if LOGGER.hasHandlers():
         LOGGER.info(message, *args)
     elif _ballenv_level() <= logging.INFO:
-        CONSOLE.handle(LOGGER.makeRecord(LOGGER.name, logging.INFO, __file__, 0, message, args, None))
+        print("ballenv: " + message % args, file=sys.stderr, flush=True)
 
 
 class CompileNotice(event.Listener):
