@@ -38,6 +38,8 @@ class Solver(NamedTuple):
     dt_min: float  # s
     adaptive: bool
     growth: float
+    rtol: float  # local error tolerance relative to the ring's radius; 0: no error control
+    atol: float  # m: absolute local error tolerance on positions
 
 
 def generalized_alpha_parameters(rho_infinity):
@@ -76,6 +78,8 @@ def build_solver(scene):
         dt_min=float(scene.dt_min),
         adaptive=bool(scene.adaptive),
         growth=STEP_GROWTH,
+        rtol=float(scene.rtol) if scene.adaptive else 0.0,
+        atol=float(scene.atol),
     )
 
 

@@ -66,7 +66,8 @@ COUNTERS = Layout(
     "events",  # event rows written
     "rejection",  # why the last step was rejected: a REJECT_ code
     ("by_reason", len(REJECTIONS)),  # rejected steps by REJECT_ code (slot code - 1)
-    "impulse_rejected",  # adaptive steps rejected for a contact impulse above impulse_tol
+    "impulse_rejected",  # adaptive steps rejected for a contact impulse above its bound
+    "error_rejected",  # error-controlled steps rejected for a local error above tolerance
     "energy_projected",  # accepted (step, ring) pairs whose energy gain was removed
 )
 COUNT_STEPS = COUNTERS.index("steps")
@@ -78,6 +79,7 @@ COUNT_EVENTS = COUNTERS.index("events")
 COUNT_REJECTION = COUNTERS.index("rejection")
 COUNT_BY_REASON = COUNTERS.index("by_reason")
 COUNT_IMPULSE_REJECTED = COUNTERS.index("impulse_rejected")
+COUNT_ERROR_REJECTED = COUNTERS.index("error_rejected")
 COUNT_ENERGY_PROJECTED = COUNTERS.index("energy_projected")
 N_COUNTERS = COUNTERS.size
 

@@ -51,7 +51,7 @@ class Model(NamedTuple):
     grounds: np.ndarray  # (G, 4): normal x, normal y, offset d (m), friction coefficient
     contact_method: int
     friction_regularization: float  # m/s
-    impulse_tol: float  # N s
+    impulse_bound: np.ndarray  # (R,) N s: the adaptive step's largest contact impulse per step
     rest_energy: np.ndarray  # (R,) J: stretching + gas energy of the inflated circle at rest
     thickness: np.ndarray  # (R,) m: wall thickness (the contact distance of two rings is h_a + h_b)
     collide: bool  # ring-ring collision (two or more rings and Scene.ring_collision)
@@ -62,7 +62,7 @@ class Model(NamedTuple):
 # Model fields with one entry per ring (the rest are scene-wide): a view of rings [a, b) slices these
 PER_RING_FIELDS = (
     "node_mass", "ea", "ei", "rest_len", "rest_turn", "width", "radius", "pressurised", "gas_constant",
-    "rest_energy", "thickness", "effect_parameters",
+    "rest_energy", "thickness", "effect_parameters", "impulse_bound",
 )  # fmt: skip
 
 
@@ -165,7 +165,7 @@ def build_model(scene, effects=EFFECTS):
             else CONTACT_PREDICTOR_CORRECTOR
         ),
         friction_regularization=float(scene.friction_regularization),
-        impulse_tol=float(scene.impulse_tol),
+        impulse_bound=impulse_bounds(scene),
         rest_energy=np.zeros(len(rings)),
         thickness=np.array([r.thickness for r in rings]),
         collide=len(rings) > 1 and scene.ring_collision,
@@ -185,6 +185,17 @@ def _fill_rest_energy(model, rings):
         x, _ = ring_geometry.initial_nodes(ring)
         total = ring_energy(model, r, x, np.zeros_like(x), parts)
         model.rest_energy[r] = total - (parts[names.index("gravity")] if "gravity" in names else 0.0)
+
+
+def impulse_bounds(scene):
+    """(R,) the adaptive step's bound on a ring's contact impulse per step (N s): ``Scene.impulse_tol``,
+    or with error control (``Scene.rtol`` > 0) ``rtol M sqrt(g R)``, relative to the momentum of the
+    ring (mass ``M``, kg; radius ``R``, m) falling its own radius (``g`` = 9.81 m/s^2 without
+    gravity)."""
+    if scene.rtol == 0.0:
+        return np.full(len(scene.rings), float(scene.impulse_tol))
+    g = float(np.hypot(*scene.gravity_vector)) or 9.81
+    return np.array([scene.rtol * ring_geometry.total_mass(r) * math.sqrt(g * r.radius) for r in scene.rings])
 
 
 def effect_parameters(scene, effects=EFFECTS):

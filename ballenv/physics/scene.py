@@ -188,7 +188,16 @@ class Scene:
             ring's total ground reaction over the step, net of the momentum that stops nodes moving
             into the ground at the step's start (arriving ones, or resting ones a collision impulse
             pushed; see ``stepper.try_step``); larger steps are rejected and shrunk by the ratio,
-            smaller ones grow by at most x1.25.
+            smaller ones grow by at most x1.25. Not used when ``rtol`` > 0 (which sets its own bound).
+        rtol: error control of the adaptive step, dimensionless in [0, 1]; 0 (default): off, the step
+            follows ``impulse_tol`` alone. Above 0 (with ``adaptive``), every step keeps two measures
+            within it: the local error estimate of the integrator (``local_error.py``), its RMS over a
+            ring's nodes at most ``atol + rtol R`` (m, ``R`` the ring's radius), and the contact impulse
+            (as for ``impulse_tol``) at most ``rtol M sqrt(g R)`` (N s, ``M`` the ring's mass: the
+            momentum of the ring falling its own radius), so the same ``rtol`` asks the same relative
+            accuracy of a 3 g ring and a 500 g ball. What it achieves on six balls:
+            ``benchmarks/accuracy.py``.
+        atol: absolute local error tolerance on positions (m) in [0, 1], added to ``rtol R``.
         friction_regularization: slip speed eps (m/s) in (0, 1] below which Coulomb friction is
             smoothed, ``mu N v / sqrt(v^2 + eps^2)``. A sticking node creeps at about eps times its
             tangential load over mu N (a ball rolling down a 0.2 rad slope: 0.5 mm/s at the default
@@ -224,6 +233,8 @@ class Scene:
     grounds: tuple = ()
     contact: str = "mass_modification"
     impulse_tol: float = 5e-3
+    rtol: float = 0.0
+    atol: float = 0.0
     friction_regularization: float = 1e-2
     gravity: float | tuple = 9.81
     damping: float = 0.0
@@ -250,6 +261,8 @@ class Scene:
         s(self, "grounds", check_sequence(o, "grounds", self.grounds, Ground, allow_empty=True))
         s(self, "contact", check_choice(o, "contact", self.contact, CONTACT_METHODS))
         s(self, "impulse_tol", check_real(o, "impulse_tol", self.impulse_tol, 0.0, 10.0, "N s", True))
+        s(self, "rtol", check_real(o, "rtol", self.rtol, 0.0, 1.0))
+        s(self, "atol", check_real(o, "atol", self.atol, 0.0, 1.0, "m"))
         s(
             self,
             "friction_regularization",

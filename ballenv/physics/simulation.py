@@ -30,6 +30,7 @@ from .layout import (
     CLOCK_T,
     COUNT_BY_REASON,
     COUNT_ENERGY_PROJECTED,
+    COUNT_ERROR_REJECTED,
     COUNT_EVENTS,
     COUNT_IMPULSE_REJECTED,
     COUNT_NEWTON,
@@ -75,7 +76,8 @@ class SimulationError(RuntimeError):
 class SimulationStats:
     """Cost of a run: accepted and rejected steps, Newton iterations (linear solves), wall time (s);
     ``rejections`` counts the rejected steps by reason ("newton", "energy", "intrusion",
-    "self_intersection", "impulse": the adaptive step's contact impulse above ``impulse_tol``);
+    "self_intersection", "impulse": the adaptive step's contact impulse above its bound, "error": the
+    local error above ``Scene.rtol``, ``atol``);
     ``energy_projected``: accepted (step, ring) pairs whose energy rose above the ring's budget (its
     start energy plus the work of actuation and collisions) by a small step error, removed from the
     ring's velocities relative to its centre of mass; ``energy_removed`` (J): the sum of those
@@ -280,6 +282,12 @@ class Simulation:
 
     def _failure_message(self, status):
         scene, t = self.scene, self.t
+        if status == STATUS_IMPULSE_AT_DT_MIN and scene.rtol > 0.0:
+            return (
+                f"the contact impulse per step or the local error stayed above Scene.rtol = {scene.rtol:g} "
+                f"at the smallest step Scene.dt_min = {scene.dt_min:g} s (t = {t:.6g} s); raise rtol or "
+                "atol, or lower dt_min."
+            )
         if status == STATUS_IMPULSE_AT_DT_MIN:
             return (
                 f"the contact impulse per step stayed above Scene.impulse_tol = {scene.impulse_tol:g} N s "
@@ -362,6 +370,7 @@ class Simulation:
             rejections={
                 **{name: int(c[COUNT_BY_REASON + k]) for k, name in enumerate(REJECTIONS)},
                 "impulse": int(c[COUNT_IMPULSE_REJECTED]),
+                "error": int(c[COUNT_ERROR_REJECTED]),
             },
             energy_projected=int(c[COUNT_ENERGY_PROJECTED]),
             energy_removed=float(clock[CLOCK_ENERGY_REMOVED]),

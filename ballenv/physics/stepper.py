@@ -25,6 +25,7 @@ from .layout import (
     CLOCK_T,
     COUNT_BY_REASON,
     COUNT_ENERGY_PROJECTED,
+    COUNT_ERROR_REJECTED,
     COUNT_EVENTS,
     COUNT_GRID,
     COUNT_IMPULSE_REJECTED,
@@ -47,6 +48,7 @@ from .layout import (
     TALLY_PROJECTED,
     TALLY_REMOVED,
 )
+from .local_error import error_exponent, error_norm
 from .model import CONTACT_NONE
 from .newton import newton_ring
 
@@ -153,16 +155,25 @@ def contact_impulse(model, solver, r, state, v0, trial, h, ws):
 
 
 @kernel(inline="always")
+def ring_error(model, solver, r, state, trial, h):
+    """Ring ``r``'s scaled local error (:func:`local_error.error_norm`; at most 1 is accepted)."""
+    return error_norm(model, solver, r, h, state.a[r], trial.a[r], state.active[r], trial.active[r])
+
+
+@kernel(inline="always")
 def try_step(model, solver, state, trial, h, ws):
     """One step of every ring from ``state`` into ``trial``.
 
-    Returns (Newton corrections, contact impulse in N s), or (-code, 0) if the step must be rejected,
-    with ``code`` one of the ``REJECT_`` reasons: a ring's Newton iteration failed, a ring gained
-    energy beyond what :func:`energy.within_energy_budget` removes, a ring crossed itself
+    Returns (Newton corrections, impulse ratio, local error): the impulse ratio is the smallest over
+    rings of ``model.impulse_bound`` over the ring's contact impulse (N s; inf without contact), the
+    local error the largest scaled estimate (:func:`ring_error`; 0 without error control). Returns
+    (-code, 0, 0) if the step must be rejected, with ``code`` one of the ``REJECT_`` reasons: a
+    ring's Newton iteration failed, a ring gained energy beyond what
+    :func:`energy.within_energy_budget` removes, a ring crossed itself
     (``model.reject_self_intersection``), or a node of one ring ended inside another
     (``model.collide``).
 
-    The contact impulse is the largest over rings of
+    A ring's contact impulse is
     ``|h sum_i f_i + kappa sum_i m min(0, v_n,i + gap_i / h) n|``: the ring's total ground reaction
     impulse over the step (its momentum change by contact, the paper's ``f dt``) less the reaction
     that stops the constrained nodes' start velocity into their ground (normal velocity ``v_n < 0``
@@ -173,7 +184,7 @@ def try_step(model, solver, state, trial, h, ws):
     holds for the Coulomb friction on such a node while it is stopped, at most ``mu`` times that
     normal impulse: its tangential impulse is counted only above ``mu kappa m |v_n + gap / h|``
     (without this, a sliding impact left a floor ``mu m v_n`` per arriving node that no step size
-    could bring under ``impulse_tol``). ``kappa`` is
+    could bring under its bound). ``kappa`` is
     the integrator's reaction to an arrival per unit momentum: 1 for backward Euler,
     ``(1 - alpha_m) / beta`` for generalized-alpha (whose Newmark update reflects the node's normal
     velocity before :func:`contact.rest_on_grounds` removes it).
@@ -186,19 +197,24 @@ def try_step(model, solver, state, trial, h, ws):
     the contact impulse (the part that stops an approaching node does not shrink with the step).
     """
     total = 0
-    impulse = 0.0
+    impulse_ratio = math.inf
+    error = 0.0
     ws.energy_tally[:] = 0.0
     v0 = ws.collision.kicked if collision_kicks(model, state, h, ws) else state.v
     for r in range(state.x.shape[0]):
         its = step_ring(model, solver, r, state, v0, trial, h, ws)
         if its < 0:
-            return its, 0.0
+            return its, 0.0, 0.0
         total += its
         if model.contact_method != CONTACT_NONE:
-            impulse = max(impulse, contact_impulse(model, solver, r, state, v0, trial, h, ws))
+            impulse = contact_impulse(model, solver, r, state, v0, trial, h, ws)
+            if impulse > 0.0:
+                impulse_ratio = min(impulse_ratio, model.impulse_bound[r] / impulse)
+        if solver.rtol > 0.0:
+            error = max(error, ring_error(model, solver, r, state, trial, h))
     if model.collide and rings_intrude(trial.x, model.thickness, ws.collision):
-        return -REJECT_INTRUSION, 0.0
-    return total, impulse
+        return -REJECT_INTRUSION, 0.0, 0.0
+    return total, impulse_ratio, error
 
 
 @kernel
@@ -248,12 +264,13 @@ def step_end(solver, clock, counters, t_end, output_dt):
 
 
 @kernel(inline="always")
-def step_outcome(solver, clock, counters, h, its, ratio):
+def step_outcome(solver, clock, counters, h, its, ratio, by_error):
     """Bookkeeping of a trial step of size ``h`` (s) that returned ``its`` Newton corrections and
-    ``ratio`` = impulse_tol over its contact impulse:
+    ``ratio``, the step-size factor its tolerances allow (:func:`advance`; ``by_error``: the local
+    error, not the contact impulse, set it):
     ``CONTINUE`` (retry with the new ``clock[CLOCK_H]``), ``STATUS_DONE`` (accept it) or a failure
     status. A rejected step (``its`` < 0) is retried with half the step; an adaptive step whose
-    contact impulse exceeds ``impulse_tol`` with ``h * max(0.2, 0.9 tol / (f h))``."""
+    ``ratio`` is below 1 with ``h * max(0.2, 0.9 ratio)``."""
     if its < 0:
         counters[COUNT_REJECTION] = -its
         counters[COUNT_BY_REASON - its - 1] += 1
@@ -265,7 +282,7 @@ def step_outcome(solver, clock, counters, h, its, ratio):
         if h <= 1.001 * solver.dt_min:  # (h = stop - t carries round-off)
             return STATUS_IMPULSE_AT_DT_MIN
         counters[COUNT_REJECTED] += 1
-        counters[COUNT_IMPULSE_REJECTED] += 1
+        counters[COUNT_ERROR_REJECTED if by_error else COUNT_IMPULSE_REJECTED] += 1
         clock[CLOCK_H] = max(solver.dt_min, h * max(0.2, 0.9 * ratio))
         return CONTINUE
     return STATUS_DONE
@@ -275,7 +292,7 @@ def step_outcome(solver, clock, counters, h, its, ratio):
 def accept(model, solver, ws, state, trial, clock, counters, h, stop, at_grid, ratio, rec):
     """Take the trial step ``state -> trial`` of size ``h`` (s) ending at ``stop`` (s): tallies,
     events, the state, the clock, and the next step size: adaptive, grown by ``min(growth, 1 +
-    (ratio - 1) / 2)`` (cautious; ``ratio`` = impulse_tol over the step's contact impulse) up to
+    (ratio - 1) / 2)`` (cautious; ``ratio``: see :func:`advance`) up to
     ``dt``; fixed, back to ``dt`` once on the grid."""
     counters[COUNT_STEPS] += 1
     counters[COUNT_ENERGY_PROJECTED] += int(ws.energy_tally[TALLY_PROJECTED])
@@ -310,10 +327,12 @@ def advance(model, solver, ws, state, trial, clock, counters, t_pause, t_end, ou
     Step control: a rejected step (see :func:`try_step`) is retried with half the step, adaptive or
     not. With ring
     collision, every step is first kept within :func:`collision.collision_step_limit` (no node can
-    cross more than half the contact distance toward another ring in it). Adaptive: with
-    ground contact, a step whose contact impulse (see :func:`try_step`) exceeds ``impulse_tol`` is
-    retried with ``h * max(0.2, 0.9 tol / (f h))``; accepted steps grow by ``min(growth, 1 + (ratio -
-    1) / 2)`` (cautious), up to ``dt``.
+    cross more than half the contact distance toward another ring in it). Adaptive: the step's
+    ``ratio`` is the smallest of ``bound / (f h)`` over rings with ground contact (the contact
+    impulse, :func:`try_step`, against ``model.impulse_bound``) and, with error control
+    (``solver.rtol`` > 0), ``err^(-1/(p+1))`` of the scaled local error ``err``
+    (:mod:`.local_error`). A step with ``ratio`` < 1 is retried with ``h * max(0.2, 0.9 ratio)``;
+    accepted steps grow by ``min(growth, 1 + (ratio - 1) / 2)`` (cautious), up to ``dt``.
     """
     capacity = rec.t.shape[0]
     n_rings = state.x.shape[0]
@@ -325,9 +344,10 @@ def advance(model, solver, ws, state, trial, clock, counters, t_pause, t_end, ou
             clock[CLOCK_H] = max(min(clock[CLOCK_H], limit), solver.dt_min)
         stop, at_end, at_out, at_grid = step_end(solver, clock, counters, t_end, output_dt)
         h = stop - clock[CLOCK_T]
-        its, impulse = try_step(model, solver, state, trial, h, ws)
-        ratio = math.inf if impulse == 0.0 else model.impulse_tol / impulse
-        status = step_outcome(solver, clock, counters, h, its, ratio)
+        its, impulse_ratio, error = try_step(model, solver, state, trial, h, ws)
+        error_factor = math.inf if error == 0.0 else error ** -error_exponent(solver)
+        ratio = min(impulse_ratio, error_factor)
+        status = step_outcome(solver, clock, counters, h, its, ratio, error_factor < impulse_ratio)
         if status == CONTINUE:
             continue
         if status != STATUS_DONE:

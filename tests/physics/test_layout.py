@@ -57,7 +57,7 @@ def test_layout_rejects_a_name_declared_twice():
 def test_stats_report_every_rejection_reason_of_the_layout():
     scene = Scene(rings=[Ring(n_nodes=16)], grounds=[Ground()], adaptive=True, dt=1e-2, impulse_tol=1e-3)
     stats = simulate(scene, 0.6).stats
-    assert list(stats.rejections) == [*layout.REJECTIONS, "impulse"]
+    assert list(stats.rejections) == [*layout.REJECTIONS, "impulse", "error"]
     assert sum(stats.rejections.values()) == stats.rejected_steps > 0
 
 
