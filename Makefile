@@ -6,12 +6,12 @@ PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 export OPENBLAS_NUM_THREADS := 1
 
-.PHONY: venv train demo scenes test test-slow bench soak lint format clean clean-cache
+.PHONY: venv train demo scenes test test-slow docs bench soak lint format clean clean-cache
 
 $(STAMP): pyproject.toml constraints.txt
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -c constraints.txt -e '.[dev,plot,render,train]'
+	$(PY) -m pip install --quiet -c constraints.txt -e '.[dev,docs,plot,render,train]'
 	touch $(STAMP)
 
 venv: $(STAMP)
@@ -34,6 +34,9 @@ test: $(STAMP)
 test-slow: $(STAMP)
 	$(PY) -m pytest -q -m slow
 
+docs: $(STAMP)  # the documentation site (mkdocs.yml) into site/; a warning fails the build
+	NO_MKDOCS_2_WARNING=1 $(PY) -m mkdocs build --strict --site-dir site
+
 bench: $(STAMP)
 	$(PY) benchmarks/step_cost.py
 	$(PY) benchmarks/linear_solve.py
@@ -54,7 +57,7 @@ format: $(STAMP)
 	$(PY) -m ruff check --fix .
 
 clean: clean-cache
-	rm -rf $(VENV) out runs .pytest_cache .ruff_cache
+	rm -rf $(VENV) out runs site .pytest_cache .ruff_cache
 
 clean-cache:  # numba's compiled kernels (stale after editing a kernel that other files call)
 	find . -name __pycache__ -type d -not -path "./$(VENV)/*" -prune -exec rm -rf {} +

@@ -142,7 +142,8 @@ def parse_env_kwargs(text):
     return value
 
 
-def main(argv=None):
+def build_parser():
+    """The command line of ``python -m agents.evaluate`` / ``ballenv-evaluate``."""
     parser = argparse.ArgumentParser(prog="ballenv-evaluate", description=__doc__.split("\n")[0])
     parser.add_argument("policy", help='"random", "heuristic", a model .zip or a run folder of train.py')
     parser.add_argument("--action-mode", choices=("pressure", "paddle"), help="shortcut for env_kwargs")
@@ -151,6 +152,11 @@ def main(argv=None):
     parser.add_argument("--seed", type=int, default=DEFAULT_SEED, help="seed of the first episode")
     parser.add_argument("--algo", choices=("ppo", "sac"), help="algorithm of a bare model .zip")
     parser.add_argument("--json", help="also write the score to this file")
+    return parser
+
+
+def main(argv=None):
+    parser = build_parser()
     args = parser.parse_args(argv)
     env_kwargs = dict(args.env_kwargs or {})
     if args.env_kwargs is None and args.policy not in ("random", "heuristic"):

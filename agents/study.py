@@ -120,7 +120,8 @@ def plot(path, runs, baselines, title):
     plt.close(fig)
 
 
-def main(argv=None):
+def build_parser():
+    """The command line of ``python -m agents.study`` (arguments it does not know go to agents.train)."""
     p = argparse.ArgumentParser(prog="python -m agents.study", description=__doc__.split("\n")[0])
     p.add_argument("--algo", choices=("ppo", "sac"), default="ppo")
     p.add_argument("--action-mode", choices=("pressure", "paddle"), default="pressure")
@@ -129,7 +130,11 @@ def main(argv=None):
     p.add_argument("--episodes", type=int, default=20, help="held-out episodes per policy and run")
     p.add_argument("--out", type=pathlib.Path, default=pathlib.Path("runs/study"))
     p.add_argument("--env-kwargs", type=parse_env_kwargs, default={}, help="JSON object of env keywords")
-    args, args.train_args = p.parse_known_args(argv)  # the rest goes to agents.train
+    return p
+
+
+def main(argv=None):
+    args, args.train_args = build_parser().parse_known_args(argv)  # the rest goes to agents.train
     if args.env_kwargs:
         args.train_args += ["--env-kwargs", json.dumps(args.env_kwargs)]
     runs = [train_seed(args, seed) for seed in args.seeds]

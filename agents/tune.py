@@ -169,7 +169,8 @@ def _current_ppo(mode):
     return params
 
 
-def main(argv=None):
+def build_parser():
+    """The command line of ``python -m agents.tune`` (arguments it does not know go to agents.train)."""
     p = argparse.ArgumentParser(prog="python -m agents.tune", description=__doc__.split("\n")[0])
     p.add_argument("what", choices=("heuristic", "ppo"), help="what to tune")
     p.add_argument("--action-mode", choices=("pressure", "paddle"), default="pressure")
@@ -179,7 +180,11 @@ def main(argv=None):
     p.add_argument("--seed", type=int, default=0, help="sampler seed (ppo: trial k trains with seed + k)")
     p.add_argument("--out", type=pathlib.Path, default=pathlib.Path("runs/tune"), help="ppo: output folder")
     p.add_argument("--dry-run", action="store_true", help="heuristic: print the best, do not write it")
-    args, args.train_args = p.parse_known_args(argv)  # ppo: the rest goes to agents.train
+    return p
+
+
+def main(argv=None):
+    args, args.train_args = build_parser().parse_known_args(argv)  # ppo: the rest goes to agents.train
     (tune_heuristic if args.what == "heuristic" else tune_ppo)(args)
 
 
