@@ -1,23 +1,22 @@
-"""Drawing an env's ball to an RGB array or a pygame window (pygame-ce, the ``render`` extra).
+"""Drawing an env's ball to an RGB array (:mod:`ballenv.draw`, Pillow), a pygame window or a video.
 
 The renderer only reads state: the ring's nodes, its ground reactions, the gas pressure, the
 target and the paddle. The view follows the ball horizontally and spans the arena's lower part.
+``rgb_array`` frames need Pillow only; the ``human`` window shows the same frames with pygame-ce.
+
+    python -m ballenv.render [--out out/env.png]           # the frame strip (the README's picture)
+    python -m ballenv.render --video out/env.mp4 [--mode paddle] [--seconds 3]   # a real-time clip
 """
 
 import numpy as np
 
+from .draw import STYLE, Canvas, View, pillow
 from .envs.batch import MODE_PADDLE, env_model
 from .physics.effects.gas import ring_pressure
 
 SIZE = 480  # pixels, square
-BACKGROUND = (250, 250, 247)
-GROUND = (90, 90, 90)
-RING = (200, 60, 40)
-FORCE = (30, 110, 200)
-TARGET = (40, 150, 70)
-PADDLE = (60, 60, 160)
-TEXT = (20, 20, 20)
-FORCE_SCALE = 0.002  # m of arrow per N
+FONT_SIZE = 15  # pixels
+LINE_SPACING = 18  # pixels between the text lines
 
 
 def _pygame():
@@ -25,7 +24,7 @@ def _pygame():
         import pygame
     except ImportError as err:  # pragma: no cover - depends on the installed extras
         raise ImportError(
-            "rendering needs pygame-ce: pip install 'ballenv[render]' (or pip install pygame-ce)"
+            "the human render mode needs pygame-ce: pip install 'ballenv[render]' (or pip install pygame-ce)"
         ) from err
     return pygame
 
@@ -33,82 +32,68 @@ def _pygame():
 class BallRenderer:
     """Draws env ``e`` of a :class:`~ballenv.envs.batch.BallBatch`.
 
-    ``mode="rgb_array"`` draws off screen and returns a (H, W, 3) uint8 array without opening a
-    window; ``mode="human"`` shows a window and paces it to ``fps``.
+    ``mode="rgb_array"`` returns a (480, 480, 3) uint8 array and opens no window; ``mode="human"``
+    shows the frame in a pygame window paced to ``fps`` (frames per second).
     """
 
-    def __init__(self, config, mode, fps):
+    def __init__(self, config, mode, fps, style=STYLE):
         self.config = config
         self.mode = mode
         self.fps = fps
-        self.view_height = max(1.5, config.target_height_range[1] + 4.0 * config.largest_radius())
+        self.style = style
+        self.view_height = max(1.5, config.target_height_range[1] + 4.0 * config.largest_radius())  # m
         self.scale = SIZE / self.view_height  # pixels per m
-        self.pygame = _pygame()
+        self.grounds = config.scene().grounds
+        self.pygame = _pygame() if mode == "human" else None
         self.window = None
         self.clock = None
-        self.font = None
 
     def render(self, batch, e):
-        pg = self.pygame
-        if self.mode == "human" and self.window is None:
-            pg.display.init()
-            self.window = pg.display.set_mode((SIZE, SIZE))
-            pg.display.set_caption("InflatedBall-v1")
-            self.clock = pg.time.Clock()
-        if self.font is None:
-            pg.font.init()
-            self.font = pg.font.Font(None, 20)
-        surface = pg.Surface((SIZE, SIZE))
-        self._draw(surface, batch, e)
-        if self.mode == "human":
-            pg.event.pump()
-            self.window.blit(surface, (0, 0))
-            pg.display.flip()
-            self.clock.tick(self.fps)
-            return None
-        return np.transpose(np.array(pg.surfarray.pixels3d(surface)), axes=(1, 0, 2)).copy()
+        """The frame of env ``e`` (``rgb_array``), or None after showing it (``human``)."""
+        frame = self.frame(batch, e)
+        if self.mode != "human":
+            return frame
+        self._show(frame)
+        return None
 
-    def _draw(self, surface, batch, e):
-        pg = self.pygame
+    def frame(self, batch, e):
+        """Env ``e`` of ``batch`` drawn as a (480, 480, 3) uint8 array."""
         task = batch.task
         x = batch.state.x[e]
         centre_x = float(x[:, 0].mean())
-
-        def px(p):
-            return (
-                int(round(SIZE / 2 + (p[0] - centre_x) * self.scale)),
-                int(round(SIZE - (p[1] + 0.05 * self.view_height) * self.scale)),
-            )
-
-        surface.fill(BACKGROUND)
-        ground_y = px((centre_x, task.ground_height))[1]
-        pg.draw.rect(surface, GROUND, (0, ground_y, SIZE, SIZE - ground_y))
-        target_y = px((centre_x, task.ground_height + task.target[e]))[1]
-        for start in range(0, SIZE, 16):
-            pg.draw.line(surface, TARGET, (start, target_y), (start + 8, target_y), 2)
+        view = View(SIZE, SIZE, self.scale, centre_x - 0.5 * SIZE / self.scale, -0.05 * self.view_height)
+        canvas = Canvas(view, self.style)
+        for g in self.grounds:
+            canvas.ground(g.angle, g.height, g.x)
+        canvas.level(task.ground_height + task.target[e])
         if task.mode == MODE_PADDLE:
-            top = px((centre_x, task.paddle_height[e]))[1]
-            band = int(round(task.paddle_reach * self.scale))
-            shade = pg.Surface((SIZE // 3, 2 * band), pg.SRCALPHA)
-            shade.fill((*PADDLE, 40))
-            surface.blit(shade, (SIZE // 3, top - band))
-            width = 6 if task.impulse[e] > 0.0 else 3
-            pg.draw.line(surface, PADDLE, (SIZE // 3, top), (2 * SIZE // 3, top), width)
-        points = [px(p) for p in x]
-        pg.draw.polygon(surface, RING, points, 2)
-        force = batch.state.contact_force[e]
-        for p, f in zip(x, force, strict=True):
-            if f[0] != 0.0 or f[1] != 0.0:
-                tip = (p[0] + FORCE_SCALE * f[0], p[1] + FORCE_SCALE * f[1])
-                pg.draw.line(surface, FORCE, px(p), px(tip), 2)
-        pressure = ring_pressure(env_model(batch.model, e), 0, x)
-        lines = [
+            canvas.paddle(task.paddle_height[e], task.paddle_reach, task.impulse[e] > 0.0)
+        canvas.ring(x, 0)
+        canvas.forces(x, batch.state.contact_force[e])
+        canvas.text(self._labels(batch, e), size=FONT_SIZE, spacing=LINE_SPACING)
+        return canvas.array()
+
+    @staticmethod
+    def _labels(batch, e):
+        task = batch.task
+        pressure = ring_pressure(env_model(batch.model, e), 0, batch.state.x[e])
+        return [
             f"t = {task.steps[e] * task.control_dt:5.2f} s",
             f"p = {pressure / 1e3:6.1f} kPa (gas {task.setpoint[e] / 1e3:4.1f} kPa at rest)",
             f"target {task.target[e]:.2f} m, last apex {task.apex_height[e]:.2f} m",
         ]
-        for k, line in enumerate(lines):
-            surface.blit(self.font.render(line, True, TEXT), (8, 8 + 18 * k))
+
+    def _show(self, frame):
+        pg = self.pygame
+        if self.window is None:
+            pg.display.init()
+            self.window = pg.display.set_mode((SIZE, SIZE))
+            pg.display.set_caption("InflatedBall-v1")
+            self.clock = pg.time.Clock()
+        pg.event.pump()
+        self.window.blit(pg.image.frombuffer(frame.tobytes(), (SIZE, SIZE), "RGB"), (0, 0))
+        pg.display.flip()
+        self.clock.tick(self.fps)
 
     def close(self):
         if self.window is not None:
@@ -116,50 +101,95 @@ class BallRenderer:
             self.window = None
 
 
-def frame_strip(out, steps=(0, 30, 36, 42, 90), seed=3):
-    """Write a PNG strip of frames of both action modes under their scripted controllers."""
+def scripted(mode, **env_kwargs):
+    """InflatedBall-v1 (``action_mode=mode``, ``rgb_array`` frames) and its scripted controller
+    (the pump or the dribble): ``(env, controller)``."""
     import gymnasium as gym
 
     from .controllers import PaddleDribble, PressurePump
     from .physics.ring import total_mass
 
+    env = gym.make("InflatedBall-v1", action_mode=mode, render_mode="rgb_array", **env_kwargs)
+    config = env.unwrapped.config
+    structure = env.unwrapped.observation_structure
+    if mode == "pressure":
+        return env, PressurePump(structure)
+    mass = total_mass(config.ring(config.initial_pressure))
+    return env, PaddleDribble(structure, mass, max_impulse=config.paddle_max_impulse)
+
+
+def play(env, controller, steps, seed=3):
+    """Yield ``(frame, info)`` at ``env.reset(seed=seed)`` and after each of ``steps`` steps of
+    ``controller`` (``info["time"]``: the frame's simulated time, s); stops when the episode ends."""
+    obs, info = env.reset(seed=seed)
+    yield env.render(), info
+    for _ in range(steps):
+        obs, _, terminated, truncated, info = env.step(controller.act(obs))
+        yield env.render(), info
+        if terminated or truncated:
+            return
+
+
+def frame_strip(out, steps=(0, 30, 36, 42, 90), seed=3):
+    """Write a PNG strip of frames of both action modes under their scripted controllers: one row
+    per mode, one column per control step of ``steps``. Returns ``out``."""
     rows = []
     for mode in ("pressure", "paddle"):
-        env = gym.make("InflatedBall-v1", action_mode=mode, render_mode="rgb_array")
-        obs, _ = env.reset(seed=seed)
-        config = env.unwrapped.config
-        structure = env.unwrapped.observation_structure
-        if mode == "pressure":
-            controller = PressurePump(structure)
-        else:
-            mass = total_mass(config.ring(config.initial_pressure))
-            controller = PaddleDribble(structure, mass, max_impulse=config.paddle_max_impulse)
-        frames = []
-        for k in range(max(steps) + 1):
-            if k in steps:
-                frames.append(env.render())
-            obs, *_ = env.step(controller.act(obs))
-        rows.append(np.concatenate(frames, axis=1))
+        env, controller = scripted(mode)
+        run = play(env, controller, max(steps), seed)
+        rows.append(np.concatenate([frame for k, (frame, _) in enumerate(run) if k in steps], axis=1))
         env.close()
-    image = np.concatenate(rows, axis=0)
-    pg = _pygame()
-    pg.image.save(pg.surfarray.make_surface(np.transpose(image, (1, 0, 2))), str(out))
+    Image, _, _ = pillow()
+    Image.fromarray(np.concatenate(rows, axis=0)).save(out)
     return out
 
 
+def record_clip(path, mode="pressure", seconds=3.0, seed=3, **env_kwargs):
+    """Write a real-time video (``.mp4`` or ``.gif``) of ``seconds`` of simulated time under the
+    scripted controller in ``mode``: a frame at the reset and one per control step, at
+    ``metadata["render_fps"]`` (the control frequency), so frame k plays at its simulated time.
+    Returns ``(path, infos)``: the frames' step infos (``infos[k]["time"]``, s)."""
+    from .video import write_video
+
+    env, controller = scripted(mode, **env_kwargs)
+    fps = env.metadata["render_fps"]
+    infos = []
+
+    def frames():
+        for frame, info in play(env, controller, round(seconds * fps), seed):
+            infos.append(info)
+            yield frame
+
+    try:
+        return write_video(frames(), path, fps), infos
+    finally:
+        env.close()
+
+
 def main(argv=None):
-    """``python -m ballenv.render [--out PATH]``: write the frame strip (default ``out/env.png``,
-    outside the tracked files; the README's picture is ``--out docs/env.png``)."""
+    """``python -m ballenv.render [--out PATH] [--video PATH --mode MODE --seconds S]``: write the
+    frame strip (default ``out/env.png``, outside the tracked files; the README's picture is
+    ``--out docs/env.png``), or with ``--video`` a real-time clip (.mp4 or .gif)."""
     import argparse
-    import os
     import pathlib
 
-    os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
-    parser = argparse.ArgumentParser(description="Write a frame strip of InflatedBall-v1 (both modes).")
+    parser = argparse.ArgumentParser(
+        prog="python -m ballenv.render", description="Write a frame strip or a clip of InflatedBall-v1."
+    )
     parser.add_argument("--out", default="out/env.png", help="PNG file to write (default out/env.png)")
-    out = pathlib.Path(parser.parse_args(argv).out)
+    parser.add_argument("--video", default=None, help="write a clip instead: a .mp4 or .gif file")
+    parser.add_argument("--mode", default="pressure", choices=("pressure", "paddle"), help="the clip's mode")
+    parser.add_argument(
+        "--seconds", type=float, default=3.0, help="simulated seconds of the clip (default 3)"
+    )
+    args = parser.parse_args(argv)
+    out = pathlib.Path(args.video or args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
-    print(frame_strip(out))
+    if args.video:
+        record_clip(out, args.mode, args.seconds)
+    else:
+        frame_strip(out)
+    print(out)
 
 
 if __name__ == "__main__":

@@ -4,7 +4,8 @@
 
 ``TRAJ.npz`` is a :meth:`ballenv.physics.Trajectory.save` file (the scenes CLI writes them). The
 page needs no network and no server: the data is inlined (float32, base64) and drawn on a canvas by
-inline JavaScript. It shows the ring(s), the grounds, the ground reaction per node (blue arrows)
+inline JavaScript, in the colours and line widths of the Python renderer (``ballenv.draw.STYLE``,
+inlined with the data). It shows the ring(s), the grounds, the ground reaction per node (blue arrows)
 and, below, each ring's gauge pressure over time with a cursor; controls: play/pause (space),
 a scrub bar, playback speed (0.05x-2x of real time), step buttons (arrow keys). Playback follows the
 recorded times, so adaptive-step records play at their true pace.
@@ -24,6 +25,7 @@ import sys
 
 import numpy as np
 
+from .draw import STYLE
 from .physics.simulation import Trajectory
 
 
@@ -43,7 +45,8 @@ def select_frames(t, max_frames):
 
 
 def viewer_data(traj, max_frames=2000, title=None):
-    """The JSON-ready dict the page plays: records (at most ``max_frames``), grounds, events."""
+    """The JSON-ready dict the page plays: records (at most ``max_frames``), grounds, events and
+    the drawing style (colours, line width, force scale: :data:`ballenv.draw.STYLE`)."""
     idx = select_frames(traj.t, max_frames)
     scene = traj.scene
     return {
@@ -60,6 +63,7 @@ def viewer_data(traj, max_frames=2000, title=None):
         ],
         "radius": [r.radius for r in scene.rings],
         "events": [[float(t), int(r), k] for t, r, k in traj.events],
+        "style": STYLE.as_json(),
         "info": (
             f"{len(scene.rings)} ring(s), N = {scene.rings[0].n_nodes}, {scene.integrator}, "
             f"{traj.stats.steps} steps, {len(traj.t)} records"
@@ -98,7 +102,7 @@ const D = JSON.parse(document.getElementById("data").textContent);
 function f32(s){const b=atob(s);const u=new Uint8Array(b.length);for(let i=0;i<b.length;i++)u[i]=b.charCodeAt(i);return new Float32Array(u.buffer);}
 const T=f32(D.t), X=f32(D.x), F=f32(D.f), P=f32(D.p);
 const nF=D.nFrames, nR=D.nRings, nN=D.nNodes, per=nR*nN*2;
-const COLORS=["#c83c28","#285ac8","#289646","#963ca0"];
+const S=D.style, COLORS=S.rings;
 const cv=document.getElementById("scene"), ctx=cv.getContext("2d");
 const pv=document.getElementById("plot"), pctx=pv.getContext("2d");
 const scrub=document.getElementById("scrub"), status=document.getElementById("status");
@@ -113,28 +117,28 @@ const follow = Math.max(span[0],span[1]) > 8*R;
 let scale = follow ? cv.height/(5*R) : Math.min(cv.width/span[0], cv.height/span[1]);
 let cx=0, cy=0;
 function px(x,y){return [cv.width/2+(x-cx)*scale, cv.height/2-(y-cy)*scale];}
-const FS=0.002;
+const FS=S.force_scale;
 let frame=0, playing=false, simTime=T[0], speed=0.25, last=null;
 function draw(k){
   frame=k; const o=k*per;
   if(follow){let sx=0,sy=0;for(let i=0;i<per;i+=2){sx+=X[o+i];sy+=X[o+i+1];}cx=sx/(per/2);cy=sy/(per/2);}
   else{cx=(lo[0]+hi[0])/2;cy=(lo[1]+hi[1])/2;}
-  ctx.fillStyle="#fafaf7";ctx.fillRect(0,0,cv.width,cv.height);
+  ctx.fillStyle=S.background;ctx.fillRect(0,0,cv.width,cv.height);
   const far=10*(cv.width+cv.height)/scale;
   for(const g of D.grounds){
     const n=[-Math.sin(g.angle),Math.cos(g.angle)], d=[Math.cos(g.angle),Math.sin(g.angle)];
     const s=(cx-g.x)*d[0]+(cy-g.height)*d[1]; const b=[g.x+s*d[0], g.height+s*d[1]];
     const q=[[b[0]-far*d[0],b[1]-far*d[1]],[b[0]+far*d[0],b[1]+far*d[1]],[b[0]+far*d[0]-far*n[0],b[1]+far*d[1]-far*n[1]],[b[0]-far*d[0]-far*n[0],b[1]-far*d[1]-far*n[1]]];
-    ctx.fillStyle="#969696";ctx.beginPath();q.forEach((p,i)=>{const c=px(p[0],p[1]);i?ctx.lineTo(c[0],c[1]):ctx.moveTo(c[0],c[1]);});ctx.fill();
+    ctx.fillStyle=S.ground;ctx.beginPath();q.forEach((p,i)=>{const c=px(p[0],p[1]);i?ctx.lineTo(c[0],c[1]):ctx.moveTo(c[0],c[1]);});ctx.fill();
   }
   for(let r=0;r<nR;r++){
-    ctx.strokeStyle=COLORS[r%COLORS.length];ctx.lineWidth=2;ctx.beginPath();
+    ctx.strokeStyle=COLORS[r%COLORS.length];ctx.lineWidth=S.line_width;ctx.beginPath();
     for(let i=0;i<=nN;i++){const j=o+(r*nN+(i%nN))*2;const c=px(X[j],X[j+1]);i?ctx.lineTo(c[0],c[1]):ctx.moveTo(c[0],c[1]);}
     ctx.stroke();
-    ctx.strokeStyle="#1e6ec8";ctx.lineWidth=2;
+    ctx.strokeStyle=S.force;ctx.lineWidth=S.line_width;
     for(let i=0;i<nN;i++){const j=o+(r*nN+i)*2;if(F[j]!==0||F[j+1]!==0){const a=px(X[j],X[j+1]),b=px(X[j]+FS*F[j],X[j+1]+FS*F[j+1]);ctx.beginPath();ctx.moveTo(a[0],a[1]);ctx.lineTo(b[0],b[1]);ctx.stroke();}}
   }
-  ctx.fillStyle="#222";ctx.font="14px monospace";
+  ctx.fillStyle=S.text;ctx.font="14px monospace";
   const ps=[];for(let r=0;r<nR;r++)ps.push((P[k*nR+r]/1e3).toFixed(1));
   ctx.fillText("t = "+T[k].toFixed(4)+" s   p = "+ps.join(", ")+" kPa",8,18);
   scrub.value=k;

@@ -7,8 +7,10 @@ import pytest
 
 from ballenv import scenes
 from ballenv.scenes.__main__ import main
+from ballenv.video import video_info
 
 FAST = {"fidelity": "fast", "reduced": True}
+GIF_ONLY = ["--video", "gif", "--frames", "6"]
 
 
 def test_unknown_scene_lists_the_names():
@@ -91,7 +93,13 @@ def test_cli_writes_figure_video_numbers_and_trajectories(tmp_path, capsys):
     assert (
         main(["two-balls", "--out", str(tmp_path), "--fidelity", "fast", "--reduced", "--frames", "12"]) == 0
     )
-    for name in ("two-balls.png", "two-balls.gif", "two-balls.json", "two-balls-collision.npz"):
+    for name in (
+        "two-balls.png",
+        "two-balls.gif",
+        "two-balls.mp4",
+        "two-balls.json",
+        "two-balls-collision.npz",
+    ):
         assert (tmp_path / name).stat().st_size > 500, name
     record = json.loads((tmp_path / "two-balls.json").read_text())
     assert record["parameters"]["speed"] == 3.0 and record["metrics"]["restitution"] > 0.3
@@ -99,6 +107,11 @@ def test_cli_writes_figure_video_numbers_and_trajectories(tmp_path, capsys):
 
     with Image.open(tmp_path / "two-balls.gif") as gif:
         assert gif.n_frames == 12
+    assert video_info(tmp_path / "two-balls.mp4") == (12, 4.0)  # 0.25 s slowed down to 4 s
+    assert (
+        main(["two-balls", "--out", str(tmp_path / "gif"), "--fidelity", "fast", "--reduced"] + GIF_ONLY) == 0
+    )
+    assert sorted(p.suffix for p in (tmp_path / "gif").iterdir()) == [".gif", ".json", ".npz", ".png"]
     assert main(["--list"]) == 0
     assert "rolling" in capsys.readouterr().out
     with pytest.raises(SystemExit):

@@ -1,5 +1,6 @@
 """The replay page: self-contained, and it plays in a real headless browser (Debian's chromium)."""
 
+import json
 import os
 import shutil
 import subprocess
@@ -8,6 +9,7 @@ import tempfile
 import numpy as np
 import pytest
 
+from ballenv.draw import STYLE
 from ballenv.physics import Ground, Ring, Scene, Trajectory, simulate
 from ballenv.viewer import main, select_frames, write_html
 
@@ -67,6 +69,15 @@ def test_page_is_self_contained(saved, tmp_path):
     for needle in ("http://", "https://", "<link", " src="):
         assert needle not in page, needle
     assert 'id="scrub"' in page and 'id="speed"' in page and 'id="play"' in page
+
+
+def test_page_draws_in_the_renderers_style(saved, tmp_path):
+    # colours, line width and force scale come from ballenv.draw.STYLE, inlined with the data
+    page = write_html(saved[0], tmp_path / "replay.html").read_text()
+    data, script = page.split('<script id="data" type="application/json">')[1].split("</script>", 1)
+    assert json.loads(data)["style"] == STYLE.as_json()
+    for colour in (*STYLE.as_json()["rings"], STYLE.as_json()["ground"], STYLE.as_json()["force"]):
+        assert colour not in script, colour
 
 
 def test_bad_trajectory_file_is_a_clear_error(tmp_path, capsys):

@@ -1,10 +1,11 @@
 """Run a named scene and write its figure, video, measured numbers and trajectories.
 
     python -m ballenv.scenes --list
-    python -m ballenv.scenes NAME [NAME ...] --out DIR [--fidelity balanced] [--reduced] [--no-video]
+    python -m ballenv.scenes NAME [NAME ...] --out DIR [--fidelity balanced] [--reduced] [--video mp4]
 
-Writes, in DIR: ``NAME.png`` (the figure), ``NAME.gif`` (the video), ``NAME.json`` (parameters and
-measured numbers, SI units) and ``NAME-LABEL.npz`` per simulation (``Trajectory.load``; replay with
+Writes, in DIR: ``NAME.png`` (the figure), ``NAME.gif`` and ``NAME.mp4`` (the video: a GIF for pages
+that play only GIFs inline, the MP4 in full colour), ``NAME.json`` (parameters and measured numbers,
+SI units) and ``NAME-LABEL.npz`` per simulation (``Trajectory.load``; replay with
 ``python -m ballenv.viewer DIR/NAME-LABEL.npz -o replay.html``). ``all`` runs every scene.
 """
 
@@ -16,6 +17,7 @@ import re
 import sys
 import time
 
+from ..video import FORMATS
 from . import SCENES, get
 
 
@@ -33,9 +35,13 @@ def _jsonable(value):
     return value
 
 
-def run_one(name, out, fidelity="balanced", reduced=False, video=True, save=True, frames=120, progress=True):
-    """Run scene ``name`` and write its files into ``out``; returns the written paths."""
-    from .animate import write_gif
+def run_one(
+    name, out, fidelity="balanced", reduced=False, video=FORMATS, save=True, frames=120, progress=True
+):
+    """Run scene ``name`` and write its files into ``out``: the figure, the video in each format of
+    ``video`` ("gif", "mp4"; none: ``()``), the numbers and, with ``save``, the trajectories.
+    Returns the written paths."""
+    from .animate import write_videos
     from .figures import plot
 
     info = get(name)
@@ -47,11 +53,8 @@ def run_one(name, out, fidelity="balanced", reduced=False, video=True, save=True
     paths = [plot(result, out / f"{name}.png")]
     if video and result.animate:
         trajs = [result.trajectories[label] for label in result.animate]
-        paths.append(
-            write_gif(
-                trajs, out / f"{name}.gif", labels=list(result.animate), n_frames=frames, progress=progress
-            )
-        )
+        videos = [out / f"{name}.{fmt}" for fmt in video]
+        paths += write_videos(trajs, videos, labels=list(result.animate), n_frames=frames, progress=progress)
     record = {
         "scene": name,
         "figure": info.figure,
@@ -72,16 +75,22 @@ def run_one(name, out, fidelity="balanced", reduced=False, video=True, save=True
 def main(argv=None):
     parser = argparse.ArgumentParser(
         prog="python -m ballenv.scenes",
-        description="Run named scenes of the paper: figure (PNG), video (GIF), numbers (JSON), trajectories.",
+        description="Run named scenes: figure (PNG), video (GIF, MP4), numbers (JSON), trajectories (NPZ).",
     )
     parser.add_argument("names", nargs="*", metavar="NAME", help="scene name(s), or 'all'; see --list")
     parser.add_argument("--list", action="store_true", help="list the scenes and exit")
     parser.add_argument("--out", default="out/scenes", help="output folder (default: out/scenes)")
     parser.add_argument("--fidelity", default="balanced", choices=("fast", "balanced", "accurate"))
     parser.add_argument("--reduced", action="store_true", help="fewer cases (as the tests run them)")
-    parser.add_argument("--no-video", action="store_true", help="skip the GIF")
+    parser.add_argument(
+        "--video",
+        default="both",
+        choices=(*FORMATS, "both"),
+        help="video format (default: both, GIF and MP4)",
+    )
+    parser.add_argument("--no-video", action="store_true", help="write no video")
     parser.add_argument("--no-trajectories", action="store_true", help="do not save the .npz trajectories")
-    parser.add_argument("--frames", type=int, default=120, help="frames of the GIF (default 120)")
+    parser.add_argument("--frames", type=int, default=120, help="frames of the video (default 120)")
     args = parser.parse_args(argv)
     if args.list or not args.names:
         width = max(len(n) for n in SCENES)
@@ -102,7 +111,7 @@ def main(argv=None):
             args.out,
             fidelity=args.fidelity,
             reduced=args.reduced,
-            video=not args.no_video,
+            video=() if args.no_video else FORMATS if args.video == "both" else (args.video,),
             save=not args.no_trajectories,
             frames=args.frames,
         )

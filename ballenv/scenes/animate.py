@@ -1,27 +1,20 @@
-"""Videos of trajectories: frames drawn with Pillow, written as an animated GIF.
+"""Videos of trajectories: frames drawn by :mod:`ballenv.draw`, written as MP4 or GIF by
+:mod:`ballenv.video`.
 
 Each panel shows one trajectory in a fixed view around everything it visits: the grounds (grey
 half-planes), the rings (their centrelines), the ground reaction per node (blue, 2 mm per N) and
 the time and gauge pressure. Several trajectories play side by side on one time axis.
 """
 
-import math
-
 import numpy as np
 
-from ..render import BACKGROUND, FORCE, FORCE_SCALE, RING, TEXT
+from ..draw import STYLE, Canvas, View
+from ..video import write_video
 
 PANEL = 320  # pixels, panel height
-GROUND = (150, 150, 150)  # lighter than the renderer's, the replay viewer's grey
-RINGS = (RING, (40, 90, 200), (40, 150, 70), (150, 60, 160))
-
-
-def _pil():
-    try:
-        from PIL import Image, ImageDraw
-    except ImportError as err:  # pragma: no cover - depends on the installed extras
-        raise ImportError("the scene videos need Pillow: pip install 'ballenv[plot]'") from err
-    return Image, ImageDraw
+GAP = 4  # pixels of white between panels
+TEXT_SIZE = 10  # pixels
+SHORTEST_S = 4.0  # s: a shorter trajectory plays slowed down to last this long
 
 
 class Panel:
@@ -31,7 +24,7 @@ class Panel:
 
     FOLLOW = 8.0
 
-    def __init__(self, traj, height=PANEL):
+    def __init__(self, traj, height=PANEL, style=STYLE):
         radius = max(r.radius for r in traj.scene.rings)
         margin = 0.6 * radius
         pts = traj.x.reshape(-1, 2)
@@ -42,6 +35,7 @@ class Panel:
         span = hi - lo
         self.traj = traj
         self.height = height
+        self.style = style
         self.follow = bool(np.any(span > self.FOLLOW * radius))
         if self.follow:
             self.scale = height / (5.0 * radius)
@@ -51,43 +45,25 @@ class Panel:
             self.width = int(max(0.5 * height, min(3 * height, span[0] * self.scale)))
             self.centre = (0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]))
 
-    def _origin(self, k):
-        if self.follow:
-            cx, cy = self.traj.x[k].reshape(-1, 2).mean(axis=0)
-        else:
-            cx, cy = self.centre
-        self.x0 = cx - 0.5 * self.width / self.scale
-        self.y0 = cy - 0.5 * self.height / self.scale
+    def view(self, k):
+        """The view of record ``k``: fixed, or centred on the rings when following them."""
+        centre = self.traj.x[k].reshape(-1, 2).mean(axis=0) if self.follow else self.centre
+        return View.centred(self.width, self.height, self.scale, centre)
 
-    def px(self, p):
-        return (float((p[0] - self.x0) * self.scale), float(self.height - (p[1] - self.y0) * self.scale))
-
-    def draw(self, k):
-        """The panel's image at record ``k``."""
-        Image, ImageDraw = _pil()
-        image = Image.new("RGB", (self.width, self.height), BACKGROUND)
-        draw = ImageDraw.Draw(image)
-        self._origin(k)
+    def draw(self, k, label=None):
+        """The panel's (height, width, 3) uint8 image at record ``k``, ``label`` at its foot."""
         tr = self.traj
-        far = 4.0 * (self.width + self.height) / self.scale
-        centre = np.array([self.x0, self.y0]) + 0.5 * np.array([self.width, self.height]) / self.scale
+        canvas = Canvas(self.view(k), self.style)
         for g in tr.scene.grounds:
-            a = g.angle
-            n = np.array([-math.sin(a), math.cos(a)])
-            d = np.array([math.cos(a), math.sin(a)])
-            base = np.array([g.x, g.height])
-            base = base + d * ((centre - base) @ d)  # the surface's point nearest the view
-            poly = [base - far * d, base + far * d, base + far * d - far * n, base - far * d - far * n]
-            draw.polygon([self.px(q) for q in poly], fill=GROUND)
+            canvas.ground(g.angle, g.height, g.x)
         for r in range(tr.x.shape[1]):
-            pts = [self.px(q) for q in tr.x[k, r]]
-            draw.line(pts + pts[:1], fill=RINGS[r % len(RINGS)], width=2)
-            for q, f in zip(tr.x[k, r], tr.contact_force[k, r], strict=True):
-                if f[0] != 0.0 or f[1] != 0.0:
-                    draw.line([self.px(q), self.px(q + FORCE_SCALE * f)], fill=FORCE, width=2)
+            canvas.ring(tr.x[k, r], r)
+            canvas.forces(tr.x[k, r], tr.contact_force[k, r])
         p = ", ".join(f"{q / 1e3:.1f}" for q in tr.pressure[k])
-        draw.text((6, 4), f"t = {tr.t[k]:.3f} s  p = {p} kPa", fill=TEXT)
-        return image
+        canvas.text([f"t = {tr.t[k]:.3f} s  p = {p} kPa"], at=(6, 4), size=TEXT_SIZE)
+        if label:
+            canvas.text([label], at=(6, self.height - 16), size=TEXT_SIZE)
+        return canvas.array()
 
 
 def frame_indices(t, times):
@@ -95,46 +71,37 @@ def frame_indices(t, times):
     return np.clip(np.searchsorted(t, times, side="right") - 1, 0, len(t) - 1)
 
 
+def clip_seconds(trajectories, seconds=None):
+    """The clip's length (s): ``seconds``, by default real time slowed down to last at least 4 s."""
+    return seconds or max(SHORTEST_S, max(float(tr.t[-1]) for tr in trajectories))
+
+
 def render_frames(trajectories, n_frames=120, labels=None, progress=False):
-    """RGB frames (PIL images) of ``trajectories`` side by side, ``n_frames`` evenly in time."""
-    Image, ImageDraw = _pil()
+    """RGB frames ((H, W, 3) uint8 arrays) of ``trajectories`` side by side, ``n_frames`` evenly
+    in time from 0 to the longest one's end."""
     panels = [Panel(tr) for tr in trajectories]
-    width = sum(p.width for p in panels) + 4 * (len(panels) - 1)
     t_end = max(float(tr.t[-1]) for tr in trajectories)
     times = np.linspace(0.0, t_end, n_frames)
     index = [frame_indices(tr.t, times) for tr in trajectories]
-    frames = []
+    labels = labels or [None] * len(panels)
+    gap = np.full((PANEL, GAP, 3), 255, dtype=np.uint8)
     steps = range(n_frames)
     if progress:
         from tqdm.auto import tqdm
 
         steps = tqdm(steps, desc="frames", unit="frame")
+    frames = []
     for j in steps:
-        image = Image.new("RGB", (width, PANEL), (255, 255, 255))
-        offset = 0
-        for i, panel in enumerate(panels):
-            image.paste(panel.draw(int(index[i][j])), (offset, 0))
-            if labels:
-                draw = ImageDraw.Draw(image)
-                draw.text((offset + 6, PANEL - 16), labels[i], fill=TEXT)
-            offset += panel.width + 4
-        frames.append(image)
+        images = [panel.draw(int(index[i][j]), labels[i]) for i, panel in enumerate(panels)]
+        parts = [part for image in images for part in (image, gap)][:-1]
+        frames.append(np.concatenate(parts, axis=1))
     return frames
 
 
-def write_gif(trajectories, path, labels=None, n_frames=120, duration=None, progress=False):
-    """Write an animated GIF of ``trajectories`` (side by side) to ``path``; ``duration`` (s) of the
-    whole clip (default: real time slowed so it lasts at least 4 s). Returns the path."""
+def write_videos(trajectories, paths, labels=None, n_frames=120, seconds=None, progress=False):
+    """Draw ``trajectories`` side by side once and write the frames to each of ``paths`` (``.mp4``
+    or ``.gif``), ``n_frames`` frames over ``seconds`` (s; default :func:`clip_seconds`). Returns
+    the paths."""
     frames = render_frames(trajectories, n_frames, labels, progress)
-    t_end = max(float(tr.t[-1]) for tr in trajectories)
-    duration = duration or max(4.0, t_end)
-    frames = [f.quantize(colors=32, dither=0) for f in frames]
-    frames[0].save(
-        path,
-        save_all=True,
-        append_images=frames[1:],
-        duration=max(20, int(1000 * duration / len(frames))),
-        loop=0,
-        optimize=True,
-    )
-    return path
+    fps = n_frames / clip_seconds(trajectories, seconds)
+    return [write_video(frames, path, fps) for path in paths]
