@@ -54,7 +54,7 @@ def _breathing_ring(integrator):
     """A ring without gravity whose wall starts moving outward in its oval mode (cos 2 theta)."""
     ring = Ring(n_nodes=32, pressure=10e3)
     scene = Scene(rings=[ring], gravity=0.0, integrator=integrator, rho_infinity=0.9)
-    x, _ = Simulation(scene).state.x[0], None
+    x = Simulation(scene).state.x[0]
     theta = np.arctan2(x[:, 1] - 1.0, x[:, 0])
     radial = np.stack([np.cos(theta), np.sin(theta)], axis=1)
     return scene, (0.5 * np.cos(2 * theta))[:, None] * radial
