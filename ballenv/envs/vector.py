@@ -99,7 +99,7 @@ class InflatedBallVectorEnv(VectorEnv):
         return dict(self._observation_structure)
 
     def reset(self, *, seed=None, options=None):
-        super().reset(seed=seed)
+        super().reset(seed=seed if isinstance(seed, int) else None)  # its generator takes an int only
         if seed is None:
             seeds = [None] * self.num_envs
         elif isinstance(seed, int):

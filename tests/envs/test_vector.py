@@ -125,6 +125,17 @@ def test_vector_env_spaces_and_errors():
     assert len(images) == 2 and images[0].dtype == np.uint8
 
 
+def test_vector_reset_takes_one_seed_per_env():
+    venv = InflatedBallVectorEnv(num_envs=2)
+    obs, info = venv.reset(seed=[7, 5])
+    for i, seed in enumerate((7, 5)):
+        single_obs, single_info = gym.make("InflatedBall-v1").reset(seed=seed)
+        np.testing.assert_array_equal(obs[i], single_obs)
+        assert info["target_height"][i] == single_info["target_height"]
+    with pytest.raises(ValueError, match="seed has 3 entries: must have num_envs = 2"):
+        venv.reset(seed=[1, 2, 3])
+
+
 def test_vector_step_or_render_before_reset_asks_for_a_reset():
     venv = InflatedBallVectorEnv(num_envs=2, num_threads=1, render_mode="rgb_array")
     with pytest.raises(ResetNeeded, match=r"vector step\(\) was called before reset\(\)"):
