@@ -51,13 +51,14 @@ soak: $(STAMP)  # the stability soak (about 10 minutes), not part of test or ben
 lint: $(STAMP)
 	$(PY) -m ruff check .
 	$(PY) -m ruff format --check .
+	$(PY) -m mypy  # the files and strictness: [tool.mypy] in pyproject.toml
 
 format: $(STAMP)
 	$(PY) -m ruff format .
 	$(PY) -m ruff check --fix .
 
 clean: clean-cache
-	rm -rf $(VENV) out runs site .pytest_cache .ruff_cache
+	rm -rf $(VENV) out runs site .pytest_cache .ruff_cache .mypy_cache
 
 clean-cache:  # numba's compiled kernels (stale after editing a kernel that other files call)
 	find . -name __pycache__ -type d -not -path "./$(VENV)/*" -prune -exec rm -rf {} +

@@ -8,15 +8,33 @@
   observation normalisation (``VecNormalize`` statistics) it was trained with.
 """
 
-import pathlib
+from __future__ import annotations
 
+import os
+import pathlib
+from collections.abc import Callable
+from typing import Any, Protocol
+
+import gymnasium as gym
 import numpy as np
+from numpy.typing import NDArray
 
 from ballenv.controllers import PaddleDribble, PressurePump
+from ballenv.envs.inflated_ball import ball_env
 from ballenv.physics.ring import total_mass
 
 ALGORITHMS = ("ppo", "sac")
 HEURISTIC_PARAMS = pathlib.Path(__file__).parent / "hyperparams" / "heuristic.yml"
+
+
+class Policy(Protocol):
+    """What every policy here is: ``reset(seed)`` at an episode start, then ``act(obs)``."""
+
+    name: str
+
+    def reset(self, seed: int) -> None: ...
+
+    def act(self, obs: NDArray[np.float32]) -> NDArray[np.float32]: ...
 
 
 class RandomPolicy:
@@ -24,13 +42,13 @@ class RandomPolicy:
 
     name = "random"
 
-    def __init__(self, env):
+    def __init__(self, env: gym.Env[Any, Any]) -> None:
         self.rng = np.random.default_rng(0)
 
-    def reset(self, seed):
+    def reset(self, seed: int) -> None:
         self.rng = np.random.default_rng(seed)
 
-    def act(self, obs):
+    def act(self, obs: NDArray[np.float32]) -> NDArray[np.float32]:
         return self.rng.uniform(-1.0, 1.0, size=1).astype(np.float32)
 
 
@@ -41,10 +59,11 @@ class HeuristicPolicy:
 
     name = "heuristic"
 
-    def __init__(self, env, params=None):
-        config = env.unwrapped.config
-        structure = env.unwrapped.observation_structure
+    def __init__(self, env: gym.Env[Any, Any], params: dict[str, float] | None = None) -> None:
+        ball = ball_env(env)
+        config, structure = ball.config, ball.observation_structure
         params = tuned_heuristic(config.action_mode) if params is None else dict(params)
+        self.controller: PressurePump | PaddleDribble
         if config.action_mode == "pressure":
             self.controller = PressurePump(structure, gravity=config.gravity, **params)
         else:
@@ -53,21 +72,21 @@ class HeuristicPolicy:
                 structure, mass, gravity=config.gravity, max_impulse=config.paddle_max_impulse, **params
             )
 
-    def reset(self, seed):
+    def reset(self, seed: int) -> None:
         self.controller.reset()
 
-    def act(self, obs):
+    def act(self, obs: NDArray[np.float32]) -> NDArray[np.float32]:
         return self.controller.act(obs)
 
 
-def heuristic_table():
+def heuristic_table() -> dict[str, dict[str, float]]:
     """The tuned controllers' parameters of ``hyperparams/heuristic.yml``: env id -> dict."""
     import yaml
 
     return (yaml.safe_load(HEURISTIC_PARAMS.read_text()) if HEURISTIC_PARAMS.exists() else None) or {}
 
 
-def tuned_heuristic(mode):
+def tuned_heuristic(mode: str) -> dict[str, float]:
     """The scripted controller's tuned parameters for action mode ``mode`` (a dict; empty if none)."""
     from ballenv.envs import ENV_IDS
 
@@ -84,7 +103,7 @@ class ModelPolicy:
 
     name = "trained"
 
-    def __init__(self, env, path, algo=None):
+    def __init__(self, env: gym.Env[Any, Any], path: str | os.PathLike[str], algo: str | None = None) -> None:
         import pickle
 
         from stable_baselines3 import PPO, SAC
@@ -96,7 +115,8 @@ class ModelPolicy:
             raise ValueError(f"agents.evaluate: policy file {str(path)!r} does not exist")
         algo = algo or _algo_of(path)
         self.wrapper = _run_wrapper(path, env)
-        cls = {"ppo": PPO, "sac": SAC}[algo]
+        classes: dict[str, type[PPO] | type[SAC]] = {"ppo": PPO, "sac": SAC}
+        cls = classes[algo]
         self.model = cls.load(path, device="cpu")
         self.normalize = None  # the saved VecNormalize (its env detached), frozen
         stats = path.parent / (
@@ -109,10 +129,10 @@ class ModelPolicy:
                 normalize.training = False
                 self.normalize = normalize
 
-    def reset(self, seed):
+    def reset(self, seed: int) -> None:
         pass
 
-    def act(self, obs):
+    def act(self, obs: NDArray[np.float32]) -> NDArray[np.float32]:
         if self.wrapper is not None:
             obs = self.wrapper.observation(obs)
         if self.normalize is not None:
@@ -121,7 +141,7 @@ class ModelPolicy:
         return np.asarray(action, dtype=np.float32).reshape(1)
 
 
-def _run_wrapper(path, env):
+def _run_wrapper(path: pathlib.Path, env: gym.Env[Any, Any]) -> gym.ObservationWrapper[Any, Any, Any] | None:
     """The observation wrapper of the run folder holding ``path`` around ``env`` (else None)."""
     config = path.parent / "config.yml"
     if not config.exists():
@@ -134,7 +154,7 @@ def _run_wrapper(path, env):
     return None if cls is None else cls(env)
 
 
-def _algo_of(path):
+def _algo_of(path: pathlib.Path) -> str:
     """The algorithm of a saved model from its run folder's config (or its file name)."""
     config = path.parent / "config.yml"
     if config.exists():
@@ -151,7 +171,11 @@ def _algo_of(path):
     )
 
 
-def make_policy(spec, env, algo=None):
+def make_policy(
+    spec: str | os.PathLike[str] | Callable[[gym.Env[Any, Any]], Policy],
+    env: gym.Env[Any, Any],
+    algo: str | None = None,
+) -> Policy:
     """``"random"``, ``"heuristic"``, a path to a saved model / run folder, or a callable ``env ->
     policy`` -> a policy."""
     if callable(spec):

@@ -19,15 +19,23 @@ are the task's measures):
   return.
 """
 
+from __future__ import annotations
+
 import argparse
 import json
 import math
+import os
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import asdict, dataclass
+from typing import Any
 
 import gymnasium as gym
 import numpy as np
 
-from .baselines import make_policy
+from ballenv.envs.config import BallEnvConfig
+from ballenv.envs.inflated_ball import ball_env
+
+from .baselines import Policy, make_policy
 
 ENV_ID = "ballenv:InflatedBall-v1"
 SUCCESS_TOLERANCE = 0.05  # relative apex error counted as a success
@@ -46,14 +54,14 @@ class Score:
     episode_length: float  # mean, control steps
     episode_return: float  # mean
     apexes: float  # mean per episode, missed ones included
-    episode_apex_errors: tuple = ()  # each episode's apex error, in seed order
+    episode_apex_errors: tuple[float, ...] = ()  # each episode's apex error, in seed order
 
 
-def run_episode(env, policy, seed):
+def run_episode(env: gym.Env[Any, Any], policy: Policy, seed: int) -> tuple[list[float], int, int, float]:
     """One episode; returns (relative apex errors, missed apexes, length, return)."""
     obs, _ = env.reset(seed=seed)
     policy.reset(seed)
-    config = env.unwrapped.config
+    config = ball_env(env).config
     limit = env.spec.max_episode_steps if env.spec and env.spec.max_episode_steps else None
     errors = []
     total = 0.0
@@ -61,7 +69,7 @@ def run_episode(env, policy, seed):
     missed = 0
     while True:
         obs, reward, terminated, truncated, info = env.step(policy.act(obs))
-        total += reward
+        total += float(reward)
         length += 1
         if info["apex_count"]:
             errors.append(abs(info["apex_height"] - info["target_height"]) / info["target_height"])
@@ -71,7 +79,7 @@ def run_episode(env, policy, seed):
             return errors, missed, length, total
 
 
-def missed_apexes(config, target, time_left):
+def missed_apexes(config: BallEnvConfig, target: float, time_left: float) -> int:
     """Apexes a ball bouncing to ``target`` (m) would reach in ``time_left`` (s): one per flight
     time ``2 sqrt(2 (target - R) / g)``, ``R`` the unstretched radius (the centre of a resting ball
     is about that high)."""
@@ -79,14 +87,21 @@ def missed_apexes(config, target, time_left):
     return int(round(max(time_left, 0.0) / flight))
 
 
-def evaluate(policy, env_kwargs=None, episodes=20, seed=DEFAULT_SEED, algo=None, progress=False):
+def evaluate(
+    policy: str | os.PathLike[str] | Callable[[gym.Env[Any, Any]], Policy],
+    env_kwargs: Mapping[str, Any] | None = None,
+    episodes: int = 20,
+    seed: int = DEFAULT_SEED,
+    algo: str | None = None,
+    progress: bool = False,
+) -> Score:
     """Score ``policy`` ("random", "heuristic", a saved model / run folder, or a callable ``env ->
     policy``) over ``episodes`` episodes of ``gym.make(ENV_ID, **env_kwargs)`` seeded ``seed, seed +
     1, ...``."""
     env = gym.make(ENV_ID, **(env_kwargs or {}))
     agent = make_policy(policy, env, algo)
     per_episode, hits, apexes, lengths, returns = [], 0, 0, [], []
-    seeds = range(seed, seed + episodes)
+    seeds: Iterable[int] = range(seed, seed + episodes)
     if progress:
         from tqdm.auto import tqdm
 
@@ -115,7 +130,7 @@ def evaluate(policy, env_kwargs=None, episodes=20, seed=DEFAULT_SEED, algo=None,
     )
 
 
-def table(scores):
+def table(scores: Sequence[Score]) -> str:
     """Markdown table of scores."""
     lines = [
         "| policy | episodes | apex error (mean +- 95 % CI) | apexes within 5 % | apexes per episode "
@@ -131,7 +146,7 @@ def table(scores):
     return "\n".join(lines)
 
 
-def parse_env_kwargs(text):
+def parse_env_kwargs(text: str) -> dict[str, Any]:
     """``--env-kwargs`` as a JSON object (e.g. '{"action_mode": "paddle"}')."""
     try:
         value = json.loads(text)
@@ -142,7 +157,7 @@ def parse_env_kwargs(text):
     return value
 
 
-def build_parser():
+def build_parser() -> argparse.ArgumentParser:
     """The command line of ``python -m agents.evaluate`` / ``ballenv-evaluate``."""
     parser = argparse.ArgumentParser(prog="ballenv-evaluate", description=__doc__.split("\n")[0])
     parser.add_argument("policy", help='"random", "heuristic", a model .zip or a run folder of train.py')
@@ -155,7 +170,7 @@ def build_parser():
     return parser
 
 
-def main(argv=None):
+def main(argv: Sequence[str] | None = None) -> None:
     parser = build_parser()
     args = parser.parse_args(argv)
     env_kwargs = dict(args.env_kwargs or {})
@@ -173,7 +188,7 @@ def main(argv=None):
             json.dump(asdict(score), f, indent=2)
 
 
-def _run_env_kwargs(policy):
+def _run_env_kwargs(policy: str) -> dict[str, Any]:
     """The env keyword arguments a run folder of train.py was trained with (else none)."""
     import pathlib
 

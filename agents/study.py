@@ -20,18 +20,23 @@ resamples, percentile interval), so the spread between training seeds counts, as
 used: its pin ``arch < 8`` does not import beside pandas 3.
 """
 
+from __future__ import annotations
+
 import argparse
 import json
 import pathlib
+from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .evaluate import Score, evaluate, parse_env_kwargs
 
 RESAMPLES = 2000
 
 
-def iqm(values):
+def iqm(values: ArrayLike) -> float:
     """Interquartile mean: the mean of the values between the 25th and 75th percentiles (the
     middle half, by rank; rliable's ``aggregate_iqm``, scipy's ``trim_mean(values, 0.25)``)."""
     v = np.sort(np.asarray(values, dtype=float).ravel())
@@ -39,7 +44,9 @@ def iqm(values):
     return float(v[cut : v.size - cut].mean())
 
 
-def bootstrap_iqm(runs, seed=0, resamples=RESAMPLES):
+def bootstrap_iqm(
+    runs: Sequence[ArrayLike], seed: int = 0, resamples: int = RESAMPLES
+) -> tuple[float, float]:
     """95 % percentile interval of the IQM of ``runs`` (a list of per-run arrays of episode scores):
     each resample draws runs with replacement, then episodes with replacement within each."""
     rng = np.random.default_rng(seed)
@@ -52,7 +59,7 @@ def bootstrap_iqm(runs, seed=0, resamples=RESAMPLES):
     return float(low), float(high)
 
 
-def summarise(name, scores):
+def summarise(name: str, scores: Sequence[Score]) -> dict[str, Any]:
     """One table row (a dict) of ``scores``, one :class:`Score` per run."""
     runs = [s.episode_apex_errors for s in scores]
     low, high = bootstrap_iqm(runs)
@@ -65,7 +72,7 @@ def summarise(name, scores):
     }  # fmt: skip
 
 
-def table(rows):
+def table(rows: Sequence[dict[str, Any]]) -> str:
     lines = [
         "| policy | runs x episodes | apex error IQM [95 % CI] | apex error mean | apexes within 5 % "
         "| return |",
@@ -80,7 +87,7 @@ def table(rows):
     return "\n".join(lines)
 
 
-def train_seed(args, seed):
+def train_seed(args: argparse.Namespace, seed: int) -> pathlib.Path:
     """The run folder of ``seed``, trained now unless it holds scores already."""
     from .train import parse_args, train
 
@@ -94,7 +101,9 @@ def train_seed(args, seed):
     return train(parse_args(argv))
 
 
-def plot(path, runs, baselines, title):
+def plot(
+    path: pathlib.Path, runs: Sequence[pathlib.Path], baselines: Sequence[dict[str, Any]], title: str
+) -> None:
     """Mean periodic-evaluation return over seeds (band: lowest to highest seed) against env steps,
     the baselines' held-out returns as lines."""
     import matplotlib
@@ -120,7 +129,7 @@ def plot(path, runs, baselines, title):
     plt.close(fig)
 
 
-def build_parser():
+def build_parser() -> argparse.ArgumentParser:
     """The command line of ``python -m agents.study`` (arguments it does not know go to agents.train)."""
     p = argparse.ArgumentParser(prog="python -m agents.study", description=__doc__.split("\n")[0])
     p.add_argument("--algo", choices=("ppo", "sac"), default="ppo")
@@ -133,8 +142,9 @@ def build_parser():
     return p
 
 
-def main(argv=None):
-    args, args.train_args = build_parser().parse_known_args(argv)  # the rest goes to agents.train
+def main(argv: Sequence[str] | None = None) -> None:
+    args, rest = build_parser().parse_known_args(argv)
+    args.train_args = rest  # goes to agents.train
     if args.env_kwargs:
         args.train_args += ["--env-kwargs", json.dumps(args.env_kwargs)]
     runs = [train_seed(args, seed) for seed in args.seeds]

@@ -17,26 +17,40 @@ one folder ``{log_dir}/{algo}_{mode}_seed{seed}[_k]`` holding:
   ``agents.evaluate`` on the same held-out seeds, and ``learning_curve.png``.
 """
 
+from __future__ import annotations
+
 import argparse
 import contextlib
 import difflib
 import inspect
 import json
+import os
 import pathlib
 import shlex
 import shutil
 import sys
 import time
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import asdict
+from types import ModuleType
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import yaml
 
+if TYPE_CHECKING:
+    from stable_baselines3.common.base_class import BaseAlgorithm
+    from stable_baselines3.common.callbacks import BaseCallback
+    from stable_baselines3.common.vec_env import VecEnv
+
+    from .evaluate import Score
+
 HYPERPARAMS = pathlib.Path(__file__).parent / "hyperparams"
 RUN_KEYS = ("n_timesteps", "n_envs", "policy", "normalize", "env_kwargs", "env_wrapper")
+OnEvaluation = Callable[[int, float], bool]  # (env steps, mean return) -> go on training
 
 
-def parse_args(argv=None):
+def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
     from .evaluate import parse_env_kwargs
 
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
@@ -65,7 +79,7 @@ def parse_args(argv=None):
     return p.parse_args(argv)
 
 
-def env_id(mode):
+def env_id(mode: str) -> str:
     """The registered id of action mode ``mode`` (``ballenv.envs.ENV_IDS``), module-qualified so that
     spawned workers import ballenv."""
     from ballenv.envs import ENV_IDS
@@ -73,7 +87,7 @@ def env_id(mode):
     return f"ballenv:{ENV_IDS[mode]}"
 
 
-def load_hyperparams(algo, mode):
+def load_hyperparams(algo: str, mode: str) -> dict[str, Any]:
     """The YAML entry of ``algo`` for the env id of action mode ``mode`` (a dict)."""
     from ballenv.envs import ENV_IDS
 
@@ -81,7 +95,7 @@ def load_hyperparams(algo, mode):
     return dict(table[ENV_IDS[mode]])
 
 
-def run_folder(log_dir, algo, mode, seed):
+def run_folder(log_dir: str | os.PathLike[str], algo: str, mode: str, seed: int) -> pathlib.Path:
     base = pathlib.Path(log_dir) / f"{algo}_{mode}_seed{seed}"
     path, k = base, 1
     while path.exists():
@@ -92,7 +106,7 @@ def run_folder(log_dir, algo, mode, seed):
 
 
 @contextlib.contextmanager
-def removed_on_failure(run, made_log_dir):
+def removed_on_failure(run: pathlib.Path, made_log_dir: bool) -> Iterator[pathlib.Path]:
     """Remove the run folder ``run`` if the block raises (and its parent, the log folder, if
     ``made_log_dir`` and it is left empty): a setup that fails leaves no half-made run behind."""
     try:
@@ -106,8 +120,16 @@ def removed_on_failure(run, made_log_dir):
 
 
 def make_envs(
-    env_kwargs, n_envs, seed, normalize, gamma, monitor_dir=None, training=True, subproc=False, wrapper=None
-):  # fmt: skip
+    env_kwargs: dict[str, Any],
+    n_envs: int,
+    seed: int,
+    normalize: bool,
+    gamma: float,
+    monitor_dir: pathlib.Path | None = None,
+    training: bool = True,
+    subproc: bool = False,
+    wrapper: str | None = None,
+) -> VecEnv:
     import gymnasium as gym
     from stable_baselines3.common.env_util import make_vec_env
     from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecNormalize
@@ -126,7 +148,7 @@ def make_envs(
     return envs
 
 
-def compile_once(gym, env_kwargs):
+def compile_once(gym: ModuleType, env_kwargs: dict[str, Any]) -> None:
     """Reset and step one env here, before any worker process starts: numba compiles the simulator
     once (or loads it from its cache) and the workers load it from the cache instead of each
     compiling it."""
@@ -136,13 +158,20 @@ def compile_once(gym, env_kwargs):
     env.close()
 
 
-def callbacks(run, eval_env, args, n_envs, total, on_evaluation=None):
+def callbacks(
+    run: pathlib.Path,
+    eval_env: VecEnv,
+    args: argparse.Namespace,
+    n_envs: int,
+    total: int,
+    on_evaluation: OnEvaluation | None = None,
+) -> list[BaseCallback]:
     from stable_baselines3.common.callbacks import BaseCallback, CheckpointCallback, EvalCallback
 
     class SaveNormalization(BaseCallback):
         """Save the VecNormalize statistics with each new best model."""
 
-        def _on_step(self):
+        def _on_step(self) -> bool:
             env = self.model.get_vec_normalize_env()
             if env is not None:
                 env.save(str(run / "best_vecnormalize.pkl"))
@@ -151,32 +180,37 @@ def callbacks(run, eval_env, args, n_envs, total, on_evaluation=None):
     class ProgressBar(BaseCallback):
         """A tqdm bar over env steps (SB3's own needs the `rich` package)."""
 
-        def _on_training_start(self):
+        def _on_training_start(self) -> None:
             from tqdm.auto import tqdm
 
             self.bar = tqdm(total=total, unit="step", desc=f"train {args.algo}", smoothing=0.1)
 
-        def _on_step(self):
+        def _on_step(self) -> bool:
             self.bar.n = self.num_timesteps
             self.bar.refresh() if self.n_calls % 50 == 0 else None
             return True
 
-        def _on_training_end(self):
+        def _on_training_end(self) -> None:
             self.bar.n = self.num_timesteps
             self.bar.close()
 
     class AfterEvaluation(BaseCallback):
-        """Hand each periodic evaluation to ``on_evaluation(env steps, mean return)``; its False
-        stops the training (a pruned tuning trial)."""
+        """Hand each periodic evaluation to ``report(env steps, mean return)``; its False stops the
+        training (a pruned tuning trial)."""
 
-        def _on_step(self):
-            return bool(on_evaluation(self.num_timesteps, float(self.parent.last_mean_reward)))
+        def __init__(self, report: OnEvaluation) -> None:
+            super().__init__()
+            self.report = report
+
+        def _on_step(self) -> bool:
+            assert isinstance(self.parent, EvalCallback)  # run after each of its evaluations
+            return bool(self.report(self.num_timesteps, float(self.parent.last_mean_reward)))
 
     every = max(args.eval_freq // n_envs, 1)
     evaluation = EvalCallback(
         eval_env, best_model_save_path=str(run), log_path=str(run), eval_freq=every,
         n_eval_episodes=args.eval_episodes, deterministic=True, callback_on_new_best=SaveNormalization(),
-        callback_after_eval=None if on_evaluation is None else AfterEvaluation(), verbose=0,
+        callback_after_eval=None if on_evaluation is None else AfterEvaluation(on_evaluation), verbose=0,
     )  # fmt: skip
     checkpoints = CheckpointCallback(
         save_freq=max(total // (5 * n_envs), 1), save_path=str(run / "checkpoints"), name_prefix="model",
@@ -189,7 +223,7 @@ class UsageError(ValueError):
     """A command-line or hyperparameter mistake: reported in one line, before any run folder exists."""
 
 
-def check_hyperparams(cls, algo_kwargs):
+def check_hyperparams(cls: type[BaseAlgorithm], algo_kwargs: Mapping[str, Any]) -> None:
     """Raise :class:`UsageError` naming every key of ``algo_kwargs`` that the algorithm ``cls``
     does not take (with the nearest valid names)."""
     taken = inspect.signature(cls.__init__).parameters
@@ -206,7 +240,7 @@ def check_hyperparams(cls, algo_kwargs):
         )
 
 
-def main(argv=None):
+def main(argv: Sequence[str] | None = None) -> None:
     """``python train.py ...`` / ``ballenv-train ...``: train, save and score (see the module doc)."""
     try:
         train(parse_args(argv))
@@ -214,7 +248,7 @@ def main(argv=None):
         sys.exit(f"ballenv-train: error: {err}")
 
 
-def train(args, on_evaluation=None):
+def train(args: argparse.Namespace, on_evaluation: OnEvaluation | None = None) -> pathlib.Path:
     """Train, save and score (unless ``args.final_episodes`` is 0); returns the run folder.
     ``on_evaluation(env steps, mean return)`` sees each periodic evaluation; its False stops the
     training. If the setup fails (an invalid env keyword, an algorithm that refuses its
@@ -222,6 +256,7 @@ def train(args, on_evaluation=None):
     import stable_baselines3
     import torch
     from stable_baselines3 import PPO, SAC
+    from stable_baselines3.common.vec_env import VecNormalize
 
     from .wrappers import wrapper_class
 
@@ -235,7 +270,8 @@ def train(args, on_evaluation=None):
     normalize = bool(hp.get("normalize", True))
     wrapper = hp.get("env_wrapper")
     algo_kwargs = {k: v for k, v in hp.items() if k not in RUN_KEYS}
-    cls = {"ppo": PPO, "sac": SAC}[args.algo]
+    classes: dict[str, type[PPO] | type[SAC]] = {"ppo": PPO, "sac": SAC}
+    cls = classes[args.algo]
     check_hyperparams(cls, algo_kwargs)
     try:
         wrapper_class(wrapper)
@@ -276,7 +312,7 @@ def train(args, on_evaluation=None):
     model.learn(total_timesteps=total, callback=callbacks(run, eval_env, args, n_envs, total, on_evaluation))
     wall = time.perf_counter() - start
     model.save(run / "model")
-    if normalize:
+    if isinstance(envs, VecNormalize):  # normalize
         envs.save(str(run / "vecnormalize.pkl"))
     envs.close()
     eval_env.close()
@@ -287,7 +323,9 @@ def train(args, on_evaluation=None):
     return run
 
 
-def score(run, args, env_kwargs, wall, steps):
+def score(
+    run: pathlib.Path, args: argparse.Namespace, env_kwargs: dict[str, Any], wall: float, steps: int
+) -> None:
     """Score the best model and the baselines on the same held-out seeds; write tables and a plot."""
     from .evaluate import evaluate, table
 
@@ -305,7 +343,7 @@ def score(run, args, env_kwargs, wall, steps):
     print(f"wrote {run / 'scores.md'} and {run / 'learning_curve.png'}")
 
 
-def plot_learning_curve(run, scores):
+def plot_learning_curve(run: pathlib.Path, scores: Sequence[Score]) -> None:
     """Mean evaluation return against env steps, with the baselines' mean returns as lines."""
     data = run / "evaluations.npz"
     if not data.exists():

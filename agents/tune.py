@@ -17,12 +17,19 @@ seeds; the held-out seeds of ``agents.evaluate`` (10,000 on) stay unseen.
   are written to ``{out}/ppo_{mode}.md`` and ``{out}/ppo_{mode}.yml``.
 """
 
+from __future__ import annotations
+
 import argparse
 import json
 import pathlib
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import yaml
+
+if TYPE_CHECKING:
+    import optuna
 
 from .baselines import HEURISTIC_PARAMS, HeuristicPolicy, heuristic_table
 from .evaluate import evaluate
@@ -39,10 +46,10 @@ HEURISTIC_SPACE = {
 }
 
 
-def heuristic_objective(mode, episodes):
+def heuristic_objective(mode: str, episodes: int) -> Callable[[optuna.Trial], float]:
     """Optuna objective: mean apex error of the controller with a trial's parameters."""
 
-    def objective(trial):
+    def objective(trial: optuna.Trial) -> float:
         params = {
             name: trial.suggest_float(name, low, high, log=log)
             for name, (low, high, log) in HEURISTIC_SPACE[mode].items()
@@ -56,7 +63,7 @@ def heuristic_objective(mode, episodes):
     return objective
 
 
-def tune_heuristic(args):
+def tune_heuristic(args: argparse.Namespace) -> optuna.Study:
     import optuna
 
     study = optuna.create_study(direction="minimize", sampler=optuna.samplers.TPESampler(seed=args.seed))
@@ -78,7 +85,7 @@ def tune_heuristic(args):
     return study
 
 
-def sample_ppo(trial):
+def sample_ppo(trial: optuna.Trial | optuna.trial.FixedTrial) -> dict[str, Any]:
     """PPO hyperparameters of one trial (RL Zoo's sampler, narrowed)."""
     n_steps = trial.suggest_categorical("n_steps", [256, 512, 1024])
     return {
@@ -98,13 +105,13 @@ def sample_ppo(trial):
     }
 
 
-def ppo_objective(args):
+def ppo_objective(args: argparse.Namespace) -> Callable[[optuna.Trial], float]:
     """Optuna objective: train one PPO trial, pruned on its periodic evaluations."""
     import optuna
 
     from .train import parse_args, train
 
-    def objective(trial):
+    def objective(trial: optuna.Trial) -> float:
         hp = sample_ppo(trial)
         argv = [
             "--algo", "ppo", "--action-mode", args.action_mode, "--vec-env", "subproc",
@@ -122,15 +129,15 @@ def ppo_objective(args):
     return objective
 
 
-def _reporter(trial):
-    def report(step, mean_return):
+def _reporter(trial: optuna.Trial) -> Callable[[int, float], bool]:
+    def report(step: int, mean_return: float) -> bool:
         trial.report(mean_return, step)
         return not trial.should_prune()  # False stops the training
 
     return report
 
 
-def tune_ppo(args):
+def tune_ppo(args: argparse.Namespace) -> optuna.Study:
     import optuna
 
     from ballenv.envs import ENV_IDS
@@ -155,7 +162,7 @@ def tune_ppo(args):
     return study
 
 
-def _current_ppo(mode):
+def _current_ppo(mode: str) -> dict[str, Any]:
     """The PPO file's values for ``mode`` as trial parameters (the first trial)."""
     from .train import load_hyperparams
 
@@ -169,7 +176,7 @@ def _current_ppo(mode):
     return params
 
 
-def build_parser():
+def build_parser() -> argparse.ArgumentParser:
     """The command line of ``python -m agents.tune`` (arguments it does not know go to agents.train)."""
     p = argparse.ArgumentParser(prog="python -m agents.tune", description=__doc__.split("\n")[0])
     p.add_argument("what", choices=("heuristic", "ppo"), help="what to tune")
@@ -183,8 +190,9 @@ def build_parser():
     return p
 
 
-def main(argv=None):
-    args, args.train_args = build_parser().parse_known_args(argv)  # ppo: the rest goes to agents.train
+def main(argv: Sequence[str] | None = None) -> None:
+    args, rest = build_parser().parse_known_args(argv)
+    args.train_args = rest  # ppo: goes to agents.train
     (tune_heuristic if args.what == "heuristic" else tune_ppo)(args)
 
 

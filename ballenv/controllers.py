@@ -4,19 +4,22 @@ Both read only the observation (through the env's ``observation_structure``, nam
 little memory of the current bounce. Call ``reset()`` at each episode start and ``act(obs)`` at each step.
 """
 
+from collections.abc import Mapping
+
 import numpy as np
+from numpy.typing import NDArray
 
 
 class _Controller:
-    def __init__(self, structure, gravity=9.81):
+    def __init__(self, structure: Mapping[str, slice], gravity: float = 9.81) -> None:
         self.s = structure
         self.g = gravity
         self.reset()
 
-    def reset(self):
+    def reset(self) -> None:
         pass
 
-    def _read(self, obs):
+    def _read(self, obs: NDArray[np.float32]) -> tuple[float, float, bool, float]:
         com = obs[self.s["centre_of_mass_position"]]
         vel = obs[self.s["centre_of_mass_velocity"]]
         force = float(obs[self.s["ground_normal_force"]].sum())
@@ -32,17 +35,25 @@ class PressurePump(_Controller):
     loss at the target; negative ``u``, down to ``floor``: the reverse timing takes energy out, gently:
     a ball knocked down to low bounces squashes too little to pump back up)."""
 
-    def __init__(self, structure, gravity=9.81, landing_height=0.35, gain=4.0, bias=0.7, floor=0.0):
+    def __init__(
+        self,
+        structure: Mapping[str, slice],
+        gravity: float = 9.81,
+        landing_height: float = 0.35,
+        gain: float = 4.0,
+        bias: float = 0.7,
+        floor: float = 0.0,
+    ) -> None:
         super().__init__(structure, gravity)
         self.landing_height = landing_height
         self.gain = gain
         self.bias = bias
         self.floor = floor
 
-    def reset(self):
+    def reset(self) -> None:
         self.amplitude = 1.0
 
-    def act(self, obs):
+    def act(self, obs: NDArray[np.float32]) -> NDArray[np.float32]:
         y, vy, contact, target = self._read(obs)
         if not contact and vy > 0.0:
             apex = y + vy * vy / (2.0 * self.g)
@@ -57,17 +68,24 @@ class PaddleDribble(_Controller):
     ``v J + J^2 / 2m`` from an impulse ``J``; it needs ``m g (h_target - r) / retention - m g (apex -
     r)``, ``retention`` being the fraction of its energy a bounce keeps."""
 
-    def __init__(self, structure, mass, gravity=9.81, retention=0.7, max_impulse=0.15):
+    def __init__(
+        self,
+        structure: Mapping[str, slice],
+        mass: float,
+        gravity: float = 9.81,
+        retention: float = 0.7,
+        max_impulse: float = 0.15,
+    ) -> None:
         super().__init__(structure, gravity)
         self.mass = mass
         self.retention = retention
         self.max_impulse = max_impulse
 
-    def reset(self):
-        self.apex = None
+    def reset(self) -> None:
+        self.apex: float | None = None
         self.struck = False
 
-    def act(self, obs):
+    def act(self, obs: NDArray[np.float32]) -> NDArray[np.float32]:
         y, vy, contact, target = self._read(obs)
         idle = np.array([-1.0], dtype=np.float32)
         if contact:

@@ -8,18 +8,33 @@ target and the paddle. The view follows the ball horizontally and spans the aren
     python -m ballenv.render --video out/env.mp4 [--mode paddle] [--seconds 3]   # a real-time clip
 """
 
-import numpy as np
+from __future__ import annotations
 
-from .draw import STYLE, Canvas, View, pillow
-from .envs.batch import MODE_PADDLE, env_model
+import os
+import pathlib
+from collections.abc import Iterator, Sequence
+from types import ModuleType
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .draw import STYLE, Canvas, Style, View, pillow
+from .envs.batch import MODE_PADDLE, BallBatch, env_model
 from .physics.effects.gas import ring_pressure
+
+if TYPE_CHECKING:
+    import gymnasium as gym
+
+    from .controllers import PaddleDribble, PressurePump
+    from .envs.config import BallEnvConfig
 
 SIZE = 480  # pixels, square
 FONT_SIZE = 15  # pixels
 LINE_SPACING = 18  # pixels between the text lines
 
 
-def _pygame():
+def _pygame() -> ModuleType:
     try:
         import pygame
     except ImportError as err:  # pragma: no cover - depends on the installed extras
@@ -36,7 +51,7 @@ class BallRenderer:
     shows the frame in a pygame window paced to ``fps`` (frames per second).
     """
 
-    def __init__(self, config, mode, fps, style=STYLE):
+    def __init__(self, config: BallEnvConfig, mode: str, fps: float, style: Style = STYLE) -> None:
         self.config = config
         self.mode = mode
         self.fps = fps
@@ -45,10 +60,10 @@ class BallRenderer:
         self.scale = SIZE / self.view_height  # pixels per m
         self.grounds = config.scene().grounds
         self.pygame = _pygame() if mode == "human" else None
-        self.window = None
-        self.clock = None
+        self.window: Any = None  # pygame's, made at the first human frame
+        self.clock: Any = None
 
-    def render(self, batch, e):
+    def render(self, batch: BallBatch, e: int) -> NDArray[np.uint8] | None:
         """The frame of env ``e`` (``rgb_array``), or None after showing it (``human``)."""
         frame = self.frame(batch, e)
         if self.mode != "human":
@@ -56,7 +71,7 @@ class BallRenderer:
         self._show(frame)
         return None
 
-    def frame(self, batch, e):
+    def frame(self, batch: BallBatch, e: int) -> NDArray[np.uint8]:
         """Env ``e`` of ``batch`` drawn as a (480, 480, 3) uint8 array."""
         task = batch.task
         x = batch.state.x[e]
@@ -74,7 +89,7 @@ class BallRenderer:
         return canvas.array()
 
     @staticmethod
-    def _labels(batch, e):
+    def _labels(batch: BallBatch, e: int) -> list[str]:
         task = batch.task
         pressure = ring_pressure(env_model(batch.model, e), 0, batch.state.x[e])
         return [
@@ -83,8 +98,9 @@ class BallRenderer:
             f"target {task.target[e]:.2f} m, last apex {task.apex_height[e]:.2f} m",
         ]
 
-    def _show(self, frame):
+    def _show(self, frame: NDArray[np.uint8]) -> None:
         pg = self.pygame
+        assert pg is not None  # human mode
         if self.window is None:
             pg.display.init()
             self.window = pg.display.set_mode((SIZE, SIZE))
@@ -95,42 +111,54 @@ class BallRenderer:
         pg.display.flip()
         self.clock.tick(self.fps)
 
-    def close(self):
-        if self.window is not None:
+    def close(self) -> None:
+        if self.window is not None and self.pygame is not None:
             self.pygame.display.quit()
             self.window = None
 
 
-def scripted(mode, **env_kwargs):
+def scripted(mode: str, **env_kwargs: Any) -> tuple[gym.Env[Any, Any], PressurePump | PaddleDribble]:
     """InflatedBall-v1 (``action_mode=mode``, ``rgb_array`` frames) and its scripted controller
     (the pump or the dribble): ``(env, controller)``."""
     import gymnasium as gym
 
     from .controllers import PaddleDribble, PressurePump
+    from .envs.inflated_ball import ball_env
     from .physics.ring import total_mass
 
     env = gym.make("InflatedBall-v1", action_mode=mode, render_mode="rgb_array", **env_kwargs)
-    config = env.unwrapped.config
-    structure = env.unwrapped.observation_structure
+    ball = ball_env(env)
+    config, structure = ball.config, ball.observation_structure
     if mode == "pressure":
         return env, PressurePump(structure)
     mass = total_mass(config.ring(config.initial_pressure))
     return env, PaddleDribble(structure, mass, max_impulse=config.paddle_max_impulse)
 
 
-def play(env, controller, steps, seed=3):
+def play(
+    env: gym.Env[Any, Any], controller: PressurePump | PaddleDribble, steps: int, seed: int = 3
+) -> Iterator[tuple[NDArray[np.uint8], dict[str, Any]]]:
     """Yield ``(frame, info)`` at ``env.reset(seed=seed)`` and after each of ``steps`` steps of
     ``controller`` (``info["time"]``: the frame's simulated time, s); stops when the episode ends."""
     obs, info = env.reset(seed=seed)
-    yield env.render(), info
+    yield _frame(env), info
     for _ in range(steps):
         obs, _, terminated, truncated, info = env.step(controller.act(obs))
-        yield env.render(), info
+        yield _frame(env), info
         if terminated or truncated:
             return
 
 
-def frame_strip(out, steps=(0, 30, 36, 42, 90), seed=3):
+def _frame(env: gym.Env[Any, Any]) -> NDArray[np.uint8]:
+    """``env.render()`` of an ``rgb_array`` env: its (H, W, 3) uint8 frame."""
+    frame = env.render()
+    assert isinstance(frame, np.ndarray)  # rgb_array mode
+    return frame
+
+
+def frame_strip(
+    out: str | os.PathLike[str], steps: Sequence[int] = (0, 30, 36, 42, 90), seed: int = 3
+) -> str | os.PathLike[str]:
     """Write a PNG strip of frames of both action modes under their scripted controllers: one row
     per mode, one column per control step of ``steps``. Returns ``out``."""
     rows = []
@@ -144,7 +172,13 @@ def frame_strip(out, steps=(0, 30, 36, 42, 90), seed=3):
     return out
 
 
-def record_clip(path, mode="pressure", seconds=3.0, seed=3, **env_kwargs):
+def record_clip(
+    path: str | os.PathLike[str],
+    mode: str = "pressure",
+    seconds: float = 3.0,
+    seed: int = 3,
+    **env_kwargs: Any,
+) -> tuple[pathlib.Path, list[dict[str, Any]]]:
     """Write a real-time video (``.mp4`` or ``.gif``) of ``seconds`` of simulated time under the
     scripted controller in ``mode``: a frame at the reset and one per control step, at
     ``metadata["render_fps"]`` (the control frequency), so frame k plays at its simulated time.
@@ -153,9 +187,9 @@ def record_clip(path, mode="pressure", seconds=3.0, seed=3, **env_kwargs):
 
     env, controller = scripted(mode, **env_kwargs)
     fps = env.metadata["render_fps"]
-    infos = []
+    infos: list[dict[str, Any]] = []
 
-    def frames():
+    def frames() -> Iterator[NDArray[np.uint8]]:
         for frame, info in play(env, controller, round(seconds * fps), seed):
             infos.append(info)
             yield frame
@@ -166,12 +200,11 @@ def record_clip(path, mode="pressure", seconds=3.0, seed=3, **env_kwargs):
         env.close()
 
 
-def main(argv=None):
+def main(argv: Sequence[str] | None = None) -> None:
     """``python -m ballenv.render [--out PATH] [--video PATH --mode MODE --seconds S]``: write the
     frame strip (default ``out/env.png``, outside the tracked files; the README's picture is
     ``--out docs/env.png``), or with ``--video`` a real-time clip (.mp4 or .gif)."""
     import argparse
-    import pathlib
 
     parser = argparse.ArgumentParser(
         prog="python -m ballenv.render", description="Write a frame strip or a clip of InflatedBall-v1."

@@ -12,12 +12,18 @@ per second (browsers slow shorter frames down), so a faster clip keeps every sec
 frame to stay in real time.
 """
 
+from __future__ import annotations
+
 import itertools
 import math
+import os
 import pathlib
+from collections.abc import Iterable
 from fractions import Fraction
+from types import ModuleType
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from .draw import pillow
 
@@ -27,8 +33,10 @@ MP4_BLOCK = 16  # px: the MP4's width and height are padded to a multiple of thi
 GIF_COLOURS = 32
 GIF_SHORTEST_MS = 20
 
+Path = str | os.PathLike[str]
 
-def _ffmpeg():
+
+def _ffmpeg() -> ModuleType:
     try:
         import imageio_ffmpeg
     except ImportError as err:  # pragma: no cover - depends on the installed extras
@@ -38,7 +46,7 @@ def _ffmpeg():
     return imageio_ffmpeg
 
 
-def video_format(path):
+def video_format(path: Path) -> str:
     """``"mp4"`` or ``"gif"`` from the suffix of ``path``; another suffix raises ValueError."""
     fmt = pathlib.Path(path).suffix.lower().lstrip(".")
     if fmt not in FORMATS:
@@ -46,14 +54,14 @@ def video_format(path):
     return fmt
 
 
-def _check_fps(fps):
+def _check_fps(fps: float | Fraction) -> None:
     if not fps > 0 or not np.isfinite(float(fps)):
         raise ValueError(
             f"video fps = {fps!r} is out of range: must be a positive number of frames per second"
         )
 
 
-def _padded(frame, height, width):
+def _padded(frame: NDArray[np.uint8], height: int, width: int) -> NDArray[np.uint8]:
     """``frame`` grown to ``height`` x ``width`` pixels by repeating its last row and column."""
     h, w = frame.shape[:2]
     if (h, w) == (height, width):
@@ -61,7 +69,9 @@ def _padded(frame, height, width):
     return np.pad(frame, ((0, height - h), (0, width - w), (0, 0)), mode="edge")
 
 
-def write_mp4(frames, path, fps, crf=MP4_CRF):
+def write_mp4(
+    frames: Iterable[ArrayLike], path: Path, fps: float | Fraction, crf: int = MP4_CRF
+) -> pathlib.Path:
     """Write ``frames`` (an iterable of (H, W, 3) uint8 arrays) as an H.264 MP4 at ``fps`` frames
     per second; sizes are padded to a multiple of 16 pixels. Returns the path."""
     _check_fps(fps)
@@ -93,7 +103,7 @@ def write_mp4(frames, path, fps, crf=MP4_CRF):
     return pathlib.Path(path)
 
 
-def gif_timing(n_frames, fps):
+def gif_timing(n_frames: int, fps: float | Fraction) -> tuple[int, list[int]]:
     """``(step, durations)``: a GIF of ``n_frames`` frames at ``fps`` keeps every ``step``-th frame,
     so that none is shorter than 20 ms, and shows kept frame j for ``durations[j]`` ms (whole
     centiseconds), so that it starts at its time (``j * step / fps`` s) to the centisecond."""
@@ -103,7 +113,9 @@ def gif_timing(n_frames, fps):
     return step, (10 * np.diff(starts_cs)).tolist()
 
 
-def write_gif(frames, path, fps, colours=GIF_COLOURS):
+def write_gif(
+    frames: Iterable[ArrayLike], path: Path, fps: float | Fraction, colours: int = GIF_COLOURS
+) -> pathlib.Path:
     """Write ``frames`` as an animated GIF (``colours`` colours, looping) that plays at ``fps``
     frames per second in real time: faster than 50 fps it keeps every second (third...) frame;
     frame times are whole centiseconds, rounded so that every frame starts on time
@@ -122,13 +134,13 @@ def write_gif(frames, path, fps, colours=GIF_COLOURS):
     return pathlib.Path(path)
 
 
-def write_video(frames, path, fps):
+def write_video(frames: Iterable[ArrayLike], path: Path, fps: float | Fraction) -> pathlib.Path:
     """Write ``frames`` at ``fps`` as an MP4 or a GIF, by the suffix of ``path``. Returns the path."""
     writer = write_mp4 if video_format(path) == "mp4" else write_gif
     return writer(frames, path, fps)
 
 
-def video_info(path):
+def video_info(path: Path) -> tuple[int, float]:
     """``(frames, seconds)`` of the video at ``path``: ffmpeg decodes an MP4 (every frame);
     a GIF's frame times are summed."""
     if video_format(path) == "mp4":

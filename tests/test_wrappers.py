@@ -16,6 +16,11 @@ from agents.wrappers import BallStateObservation, wrapper_class
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 
 
+def test_ball_state_observation_refuses_another_env():
+    with pytest.raises(TypeError, match="not an InflatedBall env"):
+        BallStateObservation(gym.make("CartPole-v1"))
+
+
 @pytest.mark.parametrize("mode", ["pressure", "paddle"])
 def test_ball_state_keeps_the_body_fields_and_the_total_ground_force(mode):
     raw = gym.make("InflatedBall-v1", action_mode=mode)

@@ -9,7 +9,7 @@ ENV_IDS = {"pressure": ENV_ID, "paddle": PADDLE_ENV_ID}  # action mode -> its en
 MAX_EPISODE_STEPS = 1000
 
 
-def register_envs():
+def register_envs() -> None:
     """Register the ids of ``ENV_IDS`` (repeatable: a second call changes nothing). Each sets its
     action mode through the spec's ``kwargs``; a keyword passed to ``gym.make`` overrides it."""
     for mode, env_id in ENV_IDS.items():

@@ -13,10 +13,12 @@ A control step of env ``e``: apply the action (set the gas, or let the paddle st
 
 import itertools
 import math
+from collections.abc import Callable, Iterator, Mapping
 from concurrent.futures import ThreadPoolExecutor
-from typing import NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..physics.actuation import apply_impulse, rest_circle_radius, restart, set_gas, set_rest_pressure
 from ..physics.contact import FREE
@@ -45,7 +47,9 @@ from ..physics.layout import (
 )
 from ..physics.model import (
     PER_RING_FIELDS,
+    Model,
     Recording,
+    Workspace,
     build_model,
     build_workspace,
     empty_state,
@@ -69,6 +73,9 @@ from .observation import (
 )
 from .observation import size as layout_size
 from .observation import structure as layout_structure
+
+if TYPE_CHECKING:
+    from ..physics.scene import Scene
 
 MODE_PRESSURE = 0
 MODE_PADDLE = 1
@@ -426,12 +433,12 @@ def observe_env(model, state, task, e, row):
         row[field_start(OBS_PADDLE_IMPULSE, n)] = task.impulse[e]
 
 
-def observation_size(n_nodes, mode):
+def observation_size(n_nodes: int, mode: int) -> int:
     """Length of the observation vector in action mode ``mode`` (see ``observation.FIELDS``)."""
     return layout_size(n_nodes, mode == MODE_PADDLE)
 
 
-def observation_structure(n_nodes, mode):
+def observation_structure(n_nodes: int, mode: int) -> dict[str, slice]:
     """Name -> slice of the observation vector in action mode ``mode`` (see ``observation.FIELDS``)."""
     return layout_structure(n_nodes, mode == MODE_PADDLE)
 
@@ -449,7 +456,15 @@ class BallBatch:
     disjoint, contiguous rows (no cache line written by two threads but at chunk ends) and scratch
     carries nothing from one env to the next: every env's numbers are those of one thread, to the bit."""
 
-    def __init__(self, scene, n_envs, task_settings, low, high, threads=1):
+    def __init__(
+        self,
+        scene: "Scene",
+        n_envs: int,
+        task_settings: Mapping[str, Any],
+        low: ArrayLike,
+        high: ArrayLike,
+        threads: int = 1,
+    ) -> None:
         self.scene = scene
         self.n_envs = n_envs
         self.n_nodes = scene.rings[0].n_nodes
@@ -492,7 +507,7 @@ class BallBatch:
         )
         self.nodes = np.zeros(self.n_nodes, dtype=np.int64)
         self.threads = max(1, min(int(threads), n_envs))
-        self._pool = None
+        self._pool: ThreadPoolExecutor | None = None
         if self.threads > 1:
             self._pool = ThreadPoolExecutor(self.threads - 1, thread_name_prefix="ballenv")
             self._scratch = [(self.ws, self.nodes)] + [
@@ -507,9 +522,13 @@ class BallBatch:
         self.raw = np.zeros((n_envs, observation_size(self.n_nodes, self.task.mode)))
         self.obs = np.zeros(self.raw.shape, dtype=np.float32)
         self.all = np.ones(n_envs, dtype=np.bool_)
-        self._step_batch = None  # the compiled entry point of the step call, once known
+        self._step_batch: Callable[..., None] | None = (
+            None  # the compiled entry point of the step call, once known
+        )
 
-    def reset(self, e, centre, velocity, phase, target, pressure):
+    def reset(
+        self, e: int, centre: ArrayLike, velocity: ArrayLike, phase: float, target: float, pressure: float
+    ) -> None:
         """Start env ``e`` afresh (see :func:`reset_env`)."""
         reset_env(
             self.model, self.solver, self.ws, self.state, self.clocks, self.counters, self.task, e,
@@ -517,7 +536,7 @@ class BallBatch:
             float(target), float(pressure), self.raw, self.low, self.high, self.obs,
         )  # fmt: skip
 
-    def step(self, actions, active=None):
+    def step(self, actions: ArrayLike, active: ArrayLike | None = None) -> None:
         """One control step of the envs marked in ``active`` (all by default); ``actions`` (E,)
         float64 in [-1, 1]."""
         active = self.all if active is None else np.ascontiguousarray(active, dtype=np.bool_)
@@ -538,13 +557,22 @@ class BallBatch:
             for call in calls:
                 call.result()
 
-    def _step_chunks(self, tickets, actions, active, ws, nodes):
+    def _step_chunks(
+        self,
+        tickets: Iterator[int],
+        actions: NDArray[np.float64],
+        active: NDArray[np.bool_],
+        ws: Workspace,
+        nodes: NDArray[np.int64],
+    ) -> None:
         for k in tickets:
             if k >= len(self._chunks):
                 return
             self._step(ws, nodes, actions, active & self._chunks[k])
 
-    def _step(self, ws, nodes, actions, active):
+    def _step(
+        self, ws: Workspace, nodes: NDArray[np.int64], actions: NDArray[np.float64], active: NDArray[np.bool_]
+    ) -> None:
         args = (
             self.model, self.solver, ws, self.state, self.trial, self.clocks, self.counters, self.records,
             self.records.events, self.task, actions, active, nodes, self.raw, self.low, self.high, self.obs,
@@ -553,14 +581,14 @@ class BallBatch:
             self._step_batch = compiled_entry(step_batch, args)
         self._step_batch(*args)
 
-    def close(self):
+    def close(self) -> None:
         """Stop the step threads (if any)."""
         if self._pool is not None:
             self._pool.shutdown()
             self._pool = None
 
 
-def compiled_entry(dispatcher, args):
+def compiled_entry(dispatcher: Any, args: tuple[Any, ...]) -> Callable[..., None]:
     """The compiled entry point of numba ``dispatcher`` for arguments of the types of ``args``
     (compiled, or loaded from the cache, on first use). Calling it skips the dispatcher's typing of
     the arguments: about 13 us per call for the ~100 arrays of a step (7 us are left, for unboxing
@@ -571,9 +599,10 @@ def compiled_entry(dispatcher, args):
     return dispatcher.overloads[signature].entry_point
 
 
-def _tiled_model(model, n_envs):
+def _tiled_model(model: Model, n_envs: int) -> Model:
     """``model`` of a one-ring scene with its per-ring arrays repeated for ``n_envs`` envs (the rings
     of different envs never meet: this is not a scene of many rings)."""
-    return model._replace(
-        **{name: np.repeat(getattr(model, name), n_envs, axis=0) for name in PER_RING_FIELDS}
-    )
+    tiled: dict[str, Any] = {
+        name: np.repeat(getattr(model, name), n_envs, axis=0) for name in PER_RING_FIELDS
+    }
+    return model._replace(**tiled)

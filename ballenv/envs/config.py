@@ -1,11 +1,16 @@
 """The keyword arguments of InflatedBall-v1, validated once, and what both envs derive from them:
 the physics scene, the task settings, the observation bounds, and the reward and episode end."""
 
+from __future__ import annotations
+
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, fields
+from typing import Any
 
 import numpy as np
 from gymnasium.error import ResetNeeded
+from numpy.typing import ArrayLike, NDArray
 
 from ..physics import Ground, Ring, Scene
 from ..physics.layout import STATUS_IMPULSE_AT_DT_MIN, STATUS_STEP_TOO_SMALL
@@ -13,7 +18,7 @@ from ..physics.presets import FIDELITY_PRESETS, with_fidelity
 from ..physics.ring import burst_pressure, inflation_ratio_of
 from ..physics.scene import check_choice, check_real
 from . import observation
-from .batch import END_FAILURE, MODE_PADDLE, MODE_PRESSURE
+from .batch import END_FAILURE, MODE_PADDLE, MODE_PRESSURE, Task
 
 ACTION_MODES = {"pressure": MODE_PRESSURE, "paddle": MODE_PADDLE}
 FAILURES = {
@@ -30,9 +35,9 @@ class BallEnvConfig:
     action_mode: str = "pressure"
     fidelity: str = "fast"
     control_frequency: float = 100.0
-    target_height_range: tuple = (0.5, 1.0)
-    start_height_range: tuple = (0.6, 1.2)
-    pressure_range: tuple = (10e3, 50e3)
+    target_height_range: tuple[float, float] = (0.5, 1.0)
+    start_height_range: tuple[float, float] = (0.6, 1.2)
+    pressure_range: tuple[float, float] = (10e3, 50e3)
     initial_pressure: float = 30e3
     pressure_rate: float = 4e5
     paddle_max_impulse: float = 0.15
@@ -52,7 +57,7 @@ class BallEnvConfig:
     arena_height: float = 5.0
     rest_height: float = 0.01
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         o = "InflatedBall-v1"
         s = object.__setattr__
         check_choice(o, "action_mode", self.action_mode, tuple(ACTION_MODES))
@@ -96,25 +101,25 @@ class BallEnvConfig:
             s(self, name, _range(o, name, getattr(self, name), low, self.arena_height, "m"))
 
     @property
-    def mode(self):
+    def mode(self) -> int:
         return ACTION_MODES[self.action_mode]
 
     @property
-    def control_dt(self):
+    def control_dt(self) -> float:
         return 1.0 / self.control_frequency
 
     @property
-    def n_nodes(self):
+    def n_nodes(self) -> int:
         return FIDELITY_PRESETS[self.fidelity]["n_nodes"]
 
-    def ring(self, pressure):
+    def ring(self, pressure: float | None) -> Ring:
         """The ball as a physics Ring holding gas ``pressure`` (Pa) at rest."""
         return Ring(
             radius=self.radius, n_nodes=self.n_nodes, youngs_modulus=self.youngs_modulus,
             thickness=self.thickness, width=self.width, density=self.density, pressure=pressure,
         )  # fmt: skip
 
-    def scene(self):
+    def scene(self) -> Scene:
         """The physics scene of one env (its ring's state is set at every reset)."""
         base = Scene(
             rings=[self.ring(self.initial_pressure)],
@@ -124,7 +129,7 @@ class BallEnvConfig:
         )
         return with_fidelity(base, self.fidelity)
 
-    def task_settings(self):
+    def task_settings(self) -> dict[str, float]:
         """The scalar fields of ``batch.Task``."""
         return {
             "mode": self.mode,
@@ -143,19 +148,19 @@ class BallEnvConfig:
             "rest_height": self.rest_height,
         }
 
-    def largest_radius(self):
+    def largest_radius(self) -> float:
         """Radius (m) of the inflated circle at the largest pressure the env can set."""
         ea = self.youngs_modulus * self.width * self.thickness
         p = max(self.pressure_range[1], self.initial_pressure)
         return self.radius / (1.0 - inflation_ratio_of(p, self.width, self.radius, self.n_nodes, ea))
 
-    def observation_bounds(self):
+    def observation_bounds(self) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
         """(low, high) float32 bounds of the observation vector (``observation.FIELDS``); observations
         are clipped to them."""
         return observation.bounds(self, self.mode == MODE_PADDLE)
 
     @classmethod
-    def from_kwargs(cls, kwargs):
+    def from_kwargs(cls, kwargs: Mapping[str, Any]) -> BallEnvConfig:
         known = {f.name for f in fields(cls)}
         unknown = sorted(set(kwargs) - known)
         if unknown:
@@ -165,7 +170,7 @@ class BallEnvConfig:
         return cls(**kwargs)
 
 
-def _check_wall(config):
+def _check_wall(config: BallEnvConfig) -> None:
     """The ring's own checks of the wall's keywords (``radius``, ``youngs_modulus``, ``thickness``,
     ``width``, ``density``: the same names on the env and on :class:`Ring`), reported as the env's."""
     try:
@@ -174,7 +179,7 @@ def _check_wall(config):
         raise ValueError(str(err).replace("Ring.", "InflatedBall-v1.", 1)) from None
 
 
-def _check_wall_holds(config, name, pressure):
+def _check_wall_holds(config: BallEnvConfig, name: str, pressure: float) -> None:
     """ValueError naming the keyword ``name`` if ``pressure`` (Pa, gauge, at rest) bursts the ball:
     above the pressure its wall holds stretched by 100 % (``ring.burst_pressure``)."""
     held = burst_pressure(config.radius, config.n_nodes, config.youngs_modulus, config.thickness)
@@ -187,7 +192,7 @@ def _check_wall_holds(config, name, pressure):
         )
 
 
-def _range(owner, name, value, low, high, unit):
+def _range(owner: str, name: str, value: Any, low: float, high: float, unit: str) -> tuple[float, float]:
     valid = f"a pair (low, high) of finite numbers with {low:g} <= low < high <= {high:g} {unit}"
     try:
         lo, hi = (float(v) for v in value)
@@ -198,7 +203,7 @@ def _range(owner, name, value, low, high, unit):
     return (lo, hi)
 
 
-def parse_actions(actions, count, what):
+def parse_actions(actions: ArrayLike, count: int, what: str) -> NDArray[np.float64]:
     """``actions`` as a float64 array of ``count`` finite numbers (any array of that size of real
     numbers: ints or floats, not bools, strings or complex), else ValueError naming ``what``."""
     try:
@@ -216,7 +221,7 @@ def parse_actions(actions, count, what):
     )
 
 
-def check_reset(has_reset, call):
+def check_reset(has_reset: bool, call: str) -> None:
     """Raise gymnasium's ``ResetNeeded`` if ``call`` ("step", "render", ...) comes before the first
     reset: until then the ball has no state (its arrays are zeros)."""
     if not has_reset:
@@ -226,7 +231,9 @@ def check_reset(has_reset, call):
         )
 
 
-def draw_reset(config, rng):
+def draw_reset(
+    config: BallEnvConfig, rng: np.random.Generator
+) -> tuple[tuple[float, float], tuple[float, float], float, float]:
     """Start values of one episode from ``rng``: centre (m), velocity (m/s), phase (rad), target (m)."""
     target = rng.uniform(*config.target_height_range)
     height = rng.uniform(*config.start_height_range)
@@ -235,7 +242,7 @@ def draw_reset(config, rng):
     return (0.0, height), (vx, 0.0), phase, target
 
 
-def failure_message(task, e):
+def failure_message(task: Task, e: int) -> str:
     """Why env ``e``'s simulator stopped, or "" if it did not."""
     if task.end[e] != END_FAILURE:
         return ""

@@ -1,14 +1,23 @@
 """InflatedBall-v1: keep an inflated elastic ball bouncing to a target apex height."""
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import gymnasium as gym
 import numpy as np
 from gymnasium import Env, spaces
 from gymnasium.utils import EzPickle
+from numpy.typing import ArrayLike, NDArray
 
 from .batch import END_REASONS, REWARD, REWARD_TERMS, REWARD_TOTAL, BallBatch, observation_structure
 from .config import BallEnvConfig, check_reset, draw_reset, failure_message, parse_actions
 
+if TYPE_CHECKING:
+    from ..render import BallRenderer
 
-class InflatedBallEnv(Env, EzPickle):
+
+class InflatedBallEnv(Env[NDArray[np.float32], NDArray[np.float32]], EzPickle):
     r"""
     ## Description
     A 2-D inflated ring (discrete elastic rods: stretching and bending of the wall, gas that follows
@@ -134,7 +143,7 @@ class InflatedBallEnv(Env, EzPickle):
 
     metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 100.0}  # control_frequency
 
-    def __init__(self, render_mode=None, **kwargs):
+    def __init__(self, render_mode: str | None = None, **kwargs: Any) -> None:
         EzPickle.__init__(self, render_mode=render_mode, **kwargs)
         self.config = BallEnvConfig.from_kwargs(kwargs)
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
@@ -149,22 +158,24 @@ class InflatedBallEnv(Env, EzPickle):
         self.action_space = spaces.Box(-1.0, 1.0, shape=(1,), dtype=np.float32)
         self._observation_structure = observation_structure(self.config.n_nodes, self.config.mode)
         self._actions = np.zeros(1)
-        self._renderer = None
+        self._renderer: BallRenderer | None = None
         self._has_reset = False
         # one frame per control step: videos (RecordVideo) and the window play in real time
         self.metadata = {**self.metadata, "render_fps": self.config.control_frequency}
 
     @property
-    def observation_structure(self):
+    def observation_structure(self) -> dict[str, slice]:
         """Name -> slice of the observation vector (a new dict: the caller may change it)."""
         return dict(self._observation_structure)
 
     @property
-    def dt(self):
+    def dt(self) -> float:
         """Control step (s)."""
         return self.config.control_dt
 
-    def reset(self, *, seed=None, options=None):
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[NDArray[np.float32], dict[str, Any]]:
         super().reset(seed=seed)
         centre, velocity, phase, target = draw_reset(self.config, self.np_random)
         self._batch.reset(0, centre, velocity, phase, target, self.config.initial_pressure)
@@ -174,7 +185,7 @@ class InflatedBallEnv(Env, EzPickle):
         info = {"target_height": float(target), "time": 0.0}
         return self._batch.obs[0].copy(), info
 
-    def step(self, action):
+    def step(self, action: ArrayLike) -> tuple[NDArray[np.float32], float, bool, bool, dict[str, Any]]:
         check_reset(self._has_reset, "step")
         a = parse_actions(action, 1, "step action")
         self._actions[0] = min(1.0, max(-1.0, a[0]))
@@ -186,9 +197,9 @@ class InflatedBallEnv(Env, EzPickle):
             self.render()
         return batch.obs[0].copy(), float(task.reward[0, REWARD_TOTAL]), end != 0, False, self._step_info()
 
-    def _step_info(self):
+    def _step_info(self) -> dict[str, Any]:
         task = self._batch.task
-        info = {name: float(task.reward[0, REWARD.index(name)]) for name in REWARD_TERMS}
+        info: dict[str, Any] = {name: float(task.reward[0, REWARD.index(name)]) for name in REWARD_TERMS}
         reason = END_REASONS[int(task.end[0])]
         info.update(
             time=float(task.steps[0] * self.config.control_dt),
@@ -203,7 +214,7 @@ class InflatedBallEnv(Env, EzPickle):
         )
         return info
 
-    def render(self):
+    def render(self) -> NDArray[np.uint8] | None:
         if self.render_mode is None:
             return None
         check_reset(self._has_reset, "render")
@@ -213,7 +224,17 @@ class InflatedBallEnv(Env, EzPickle):
             self._renderer = BallRenderer(self.config, self.render_mode, self.metadata["render_fps"])
         return self._renderer.render(self._batch, 0)
 
-    def close(self):
+    def close(self) -> None:
         if self._renderer is not None:
             self._renderer.close()
             self._renderer = None
+
+
+def ball_env(env: gym.Env[Any, Any]) -> InflatedBallEnv:
+    """The InflatedBall env under ``env``'s wrappers (TypeError for any other env)."""
+    ball = env.unwrapped
+    if not isinstance(ball, InflatedBallEnv):
+        raise TypeError(
+            f"{env} is not an InflatedBall env: InflatedBall-v1 (or InflatedBallPaddle-v1) expected"
+        )
+    return ball

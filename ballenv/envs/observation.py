@@ -12,11 +12,17 @@ is invalidated only by changes to ``batch.py`` itself: after changing a table, c
 """
 
 from collections.abc import Callable
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ..physics.jit import kernel
+
+if TYPE_CHECKING:
+    from .config import BallEnvConfig
+
+Bound = Callable[["BallEnvConfig"], "float | tuple[float, ...]"]  # config -> a number, or one per entry
 
 MAX_SPEED = 100.0  # m/s, bound of the velocity observations
 MAX_NODE_FORCE = 1e5  # N, bound of the per-node ground normal force observation
@@ -33,17 +39,17 @@ class Field(NamedTuple):
     name: str
     per_node: int
     fixed: int
-    low: Callable
-    high: Callable
+    low: Bound
+    high: Bound
     unit: str
     description: str
 
-    def size(self, n_nodes):
+    def size(self, n_nodes: int) -> int:
         """Number of entries for a ring of ``n_nodes`` nodes."""
         return self.per_node * n_nodes + self.fixed
 
 
-def _node_reach(config):
+def _node_reach(config: "BallEnvConfig") -> float:
     """Farthest a node can be from the centre of mass (m): four times the largest inflated radius."""
     return 4.0 * config.largest_radius()
 
@@ -101,7 +107,7 @@ PADDLE_FIELDS = (
 )  # fmt: skip
 
 
-def _starts(table):
+def _starts(table: tuple[Field, ...]) -> dict[str, tuple[int, int]]:
     """Name -> start of each field of ``table`` as (entries per node, fixed entries) before it."""
     per_node = fixed = 0
     out = {}
@@ -133,17 +139,17 @@ def field_start(field, n_nodes):
     return field[0] * n_nodes + field[1]
 
 
-def fields(paddle):
+def fields(paddle: bool) -> tuple[Field, ...]:
     """The fields of the observation in order: :data:`FIELDS`, then :data:`PADDLE_FIELDS` if ``paddle``."""
     return FIELDS + PADDLE_FIELDS if paddle else FIELDS
 
 
-def size(n_nodes, paddle):
+def size(n_nodes: int, paddle: bool) -> int:
     """Length of the observation vector for a ring of ``n_nodes`` nodes."""
     return sum(field.size(n_nodes) for field in fields(paddle))
 
 
-def structure(n_nodes, paddle):
+def structure(n_nodes: int, paddle: bool) -> dict[str, slice]:
     """Name -> slice of the observation vector for a ring of ``n_nodes`` nodes."""
     out = {}
     for field in fields(paddle):
@@ -152,7 +158,7 @@ def structure(n_nodes, paddle):
     return out
 
 
-def bounds(config, paddle):
+def bounds(config: "BallEnvConfig", paddle: bool) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
     """(low, high) float32 bounds of the observation vector of the env configured by ``config``."""
     n = config.n_nodes
     parts = structure(n, paddle)

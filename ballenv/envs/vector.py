@@ -7,12 +7,18 @@ Gymnasium's default ``NEXT_STEP`` mode: the step after an episode ends resets th
 action and returns the first observation of the new episode with reward 0.
 """
 
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any
+
 import numba
 import numpy as np
 from gymnasium import spaces
 from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
+from numpy.typing import ArrayLike, NDArray
 
 from .batch import (
     END_FAILURE,
@@ -26,10 +32,13 @@ from .batch import (
 from .config import BallEnvConfig, check_reset, draw_reset, failure_message, parse_actions
 from .inflated_ball import InflatedBallEnv
 
+if TYPE_CHECKING:
+    from ..render import BallRenderer
+
 DEFAULT_MAX_EPISODE_STEPS = 1000
 
 
-class InflatedBallVectorEnv(VectorEnv):
+class InflatedBallVectorEnv(VectorEnv[NDArray[np.float32], NDArray[np.float32], NDArray[Any]]):
     """``num_envs`` InflatedBall-v1 episodes advanced together (see :class:`InflatedBallEnv` for the
     task, spaces and keyword arguments; ``max_episode_steps`` truncates each episode).
 
@@ -44,9 +53,13 @@ class InflatedBallVectorEnv(VectorEnv):
     }
 
     def __init__(
-        self, num_envs=1, max_episode_steps=DEFAULT_MAX_EPISODE_STEPS, render_mode=None, num_threads=None,
-        **kwargs,
-    ):  # fmt: skip
+        self,
+        num_envs: int = 1,
+        max_episode_steps: int = DEFAULT_MAX_EPISODE_STEPS,
+        render_mode: str | None = None,
+        num_threads: int | None = None,
+        **kwargs: Any,
+    ) -> None:
         if isinstance(num_envs, bool) or not isinstance(num_envs, int) or not 1 <= num_envs <= 100_000:
             raise ValueError(
                 f"InflatedBall-v1.num_envs = {num_envs!r} is out of range: must be an integer in [1, 100000]"
@@ -65,7 +78,8 @@ class InflatedBallVectorEnv(VectorEnv):
                 f"InflatedBall-v1 vector render_mode = {render_mode!r} is out of range: must be None "
                 "or 'rgb_array'"
             )
-        most = numba.config.NUMBA_NUM_THREADS
+        # numba sets its config's values at import: its type stubs do not declare them
+        most = numba.config.NUMBA_NUM_THREADS  # type: ignore[attr-defined]
         if num_threads is None:
             num_threads = min(numba.get_num_threads(), num_envs)
         if isinstance(num_threads, bool) or not isinstance(num_threads, int) or not 1 <= num_threads <= most:
@@ -89,17 +103,20 @@ class InflatedBallVectorEnv(VectorEnv):
         self._rngs = [seeding.np_random()[0] for _ in range(num_envs)]
         self._autoreset = np.zeros(num_envs, dtype=np.bool_)
         self._actions = np.zeros(num_envs)
-        self._renderer = None
+        self._renderer: BallRenderer | None = None
         self._has_reset = False
         self.metadata = {**self.metadata, "render_fps": self.config.control_frequency}
 
     @property
-    def observation_structure(self):
+    def observation_structure(self) -> dict[str, slice]:
         """Name -> slice of each env's observation vector (a new dict: the caller may change it)."""
         return dict(self._observation_structure)
 
-    def reset(self, *, seed=None, options=None):
+    def reset(
+        self, *, seed: int | Sequence[int | None] | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[NDArray[np.float32], dict[str, Any]]:
         super().reset(seed=seed if isinstance(seed, int) else None)  # its generator takes an int only
+        seeds: list[int | None]
         if seed is None:
             seeds = [None] * self.num_envs
         elif isinstance(seed, int):
@@ -119,11 +136,15 @@ class InflatedBallVectorEnv(VectorEnv):
         info = {"target_height": self._batch.task.target.copy(), "time": np.zeros(self.num_envs)}
         return self._batch.obs.copy(), info
 
-    def _reset_env(self, i):
+    def _reset_env(self, i: int) -> None:
         centre, velocity, phase, target = draw_reset(self.config, self._rngs[i])
         self._batch.reset(i, centre, velocity, phase, target, self.config.initial_pressure)
 
-    def step(self, actions):
+    def step(
+        self, actions: ArrayLike
+    ) -> tuple[
+        NDArray[np.float32], NDArray[np.float64], NDArray[np.bool_], NDArray[np.bool_], dict[str, Any]
+    ]:
         check_reset(self._has_reset, "vector step")
         a = parse_actions(actions, self.num_envs, "vector step actions")
         np.clip(a, -1.0, 1.0, out=self._actions)
@@ -131,7 +152,7 @@ class InflatedBallVectorEnv(VectorEnv):
         batch = self._batch
         batch.step(self._actions, ~resetting)
         for i in np.flatnonzero(resetting):
-            self._reset_env(i)
+            self._reset_env(int(i))
         task = batch.task
         stepped = ~resetting
         terminated = (task.end != 0) & stepped
@@ -140,13 +161,13 @@ class InflatedBallVectorEnv(VectorEnv):
         self._autoreset = terminated | truncated
         return batch.obs.copy(), reward, terminated, truncated, self._step_info(stepped)
 
-    def _step_info(self, stepped):
+    def _step_info(self, stepped: NDArray[np.bool_]) -> dict[str, Any]:
         task = self._batch.task
         info = {name: np.where(stepped, task.reward[:, REWARD.index(name)], 0.0) for name in REWARD_TERMS}
         reasons = np.where(stepped, np.array(END_REASONS, dtype=object)[task.end], "")
         failures = np.full(self.num_envs, "", dtype=object)
         for i in np.flatnonzero(stepped & (task.end == END_FAILURE)):
-            failures[i] = failure_message(task, i)
+            failures[i] = failure_message(task, int(i))
         info.update(
             time=task.steps * self.config.control_dt,
             apex_count=np.where(stepped, task.apex_count, 0),
@@ -160,7 +181,7 @@ class InflatedBallVectorEnv(VectorEnv):
         )
         return info
 
-    def render(self):
+    def render(self) -> tuple[NDArray[np.uint8], ...] | None:
         if self.render_mode is None:
             return None
         check_reset(self._has_reset, "vector render")
@@ -168,9 +189,10 @@ class InflatedBallVectorEnv(VectorEnv):
             from ..render import BallRenderer
 
             self._renderer = BallRenderer(self.config, "rgb_array", self.metadata["render_fps"])
-        return tuple(self._renderer.render(self._batch, i) for i in range(self.num_envs))
+        frames = (self._renderer.render(self._batch, i) for i in range(self.num_envs))
+        return tuple(frame for frame in frames if frame is not None)  # rgb_array: one per env
 
-    def close_extras(self, **kwargs):
+    def close_extras(self, **kwargs: Any) -> None:
         self._batch.close()
         if self._renderer is not None:
             self._renderer.close()

@@ -61,9 +61,13 @@ flat until its top touches its bottom) get no impulse, only the rejection.
 """
 
 import math
+from typing import TYPE_CHECKING
 
 from .cyclic import next_node, prev_node
 from .jit import copy_into, kernel
+
+if TYPE_CHECKING:
+    from .scene import Scene
 
 # contact row: ring a, node i of a, ring b, edge j of b (nodes j, j+1), t in [0, 1], signed distance
 CONTACT_COLUMNS = 6
@@ -559,6 +563,6 @@ def self_intersects(x):
     return False
 
 
-def enabled(scene):
+def enabled(scene: "Scene") -> bool:
     """Two or more rings that collide (``Scene.ring_collision``)."""
     return len(scene.rings) > 1 and scene.ring_collision

@@ -18,9 +18,13 @@ released; a free node below a ground is constrained.
 """
 
 import math
+from typing import TYPE_CHECKING
 
 from .jit import kernel
 from .linalg import BAND_HALF_WIDTH
+
+if TYPE_CHECKING:
+    from .scene import Scene
 
 FREE = -1
 PENETRATION_TOLERANCE = -1e-12  # m: a free node deeper than this below a ground gets constrained
@@ -152,11 +156,11 @@ def rest_on_grounds(grounds, active, v1, a1):
         a1[i, 1] -= an * ny
 
 
-def ground_enabled(scene):
+def ground_enabled(scene: "Scene") -> bool:
     """The scene has grounds: contact is on."""
     return bool(scene.grounds)
 
 
-def friction_enabled(scene):
+def friction_enabled(scene: "Scene") -> bool:
     """A ground has friction."""
     return any(g.friction > 0.0 for g in scene.grounds)

@@ -28,17 +28,18 @@ impulse_tol at dt_min" simulator failures. Wall times: range over runs of the be
 """
 
 import dataclasses
+from typing import Any
 
 from .scene import Scene, check_choice
 
-FIDELITY_PRESETS = {
+FIDELITY_PRESETS: dict[str, dict[str, Any]] = {
     "fast": {"n_nodes": 32, "dt": 2e-2, "impulse_tol": 1e-2, "newton_tol": 1e-6, "rho_infinity": 0.3},
     "balanced": {"n_nodes": 64, "dt": 1e-2, "impulse_tol": 2e-3, "newton_tol": 1e-9, "rho_infinity": 0.3},
     "accurate": {"n_nodes": 128, "dt": 5e-3, "impulse_tol": 5e-4, "newton_tol": 1e-10, "rho_infinity": 0.3},
 }
 
 
-def with_fidelity(scene, fidelity):
+def with_fidelity(scene: Scene, fidelity: str) -> Scene:
     """``scene`` with the numerical settings of preset ``fidelity`` ("fast" | "balanced" | "accurate")."""
     check_choice("with_fidelity", "fidelity", fidelity, tuple(FIDELITY_PRESETS))
     if not isinstance(scene, Scene):

@@ -24,48 +24,53 @@ must stay below 1 (beyond, no wall tension can hold the gas).
 """
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import NDArray
 
 from .jit import kernel
 
+if TYPE_CHECKING:
+    from .scene import Ring
 
-def rest_edge_length(radius, n_nodes):
+
+def rest_edge_length(radius: float, n_nodes: int) -> float:
     """``l0 = 2 R sin(pi / N)`` (m)."""
     return 2.0 * radius * math.sin(math.pi / n_nodes)
 
 
-def rest_turning_angle(n_nodes):
+def rest_turning_angle(n_nodes: int) -> float:
     """``phi0 = 2 pi / N`` (rad)."""
     return 2.0 * math.pi / n_nodes
 
 
-def rest_area(radius, n_nodes):
+def rest_area(radius: float, n_nodes: int) -> float:
     """Area of the regular N-gon inscribed in the circle (m^2)."""
     return 0.5 * n_nodes * radius**2 * math.sin(2.0 * math.pi / n_nodes)
 
 
-def stretching_stiffness(ring):
+def stretching_stiffness(ring: "Ring") -> float:
     """``EA = E b h`` (N)."""
     return ring.youngs_modulus * ring.width * ring.thickness
 
 
-def bending_stiffness(ring):
+def bending_stiffness(ring: "Ring") -> float:
     """``EI = E b h^3 / 12`` (N m^2)."""
     return ring.youngs_modulus * ring.width * ring.thickness**3 / 12.0
 
 
-def node_mass(ring):
+def node_mass(ring: "Ring") -> float:
     """``m = rho b h l0`` (kg)."""
     return ring.density * ring.width * ring.thickness * rest_edge_length(ring.radius, ring.n_nodes)
 
 
-def total_mass(ring):
+def total_mass(ring: "Ring") -> float:
     """Mass of the whole ring (kg)."""
     return ring.n_nodes * node_mass(ring)
 
 
-def burst_pressure(radius, n_nodes, youngs_modulus, thickness):
+def burst_pressure(radius: float, n_nodes: int, youngs_modulus: float, thickness: float) -> float:
     """The largest gauge pressure (Pa) a ring holds at rest: ``E h / (2 R cos(pi / N))``, where
     ``q = 1/2`` and the inflated wall is stretched by 100 % (``q / (1 - q)``); ``Ring.pressure``'s
     upper bound."""
@@ -78,7 +83,7 @@ def inflation_ratio_of(pressure, width, radius, n_nodes, ea):
     return pressure * width * radius * math.cos(math.pi / n_nodes) / ea
 
 
-def inflation_ratio(ring):
+def inflation_ratio(ring: "Ring") -> float:
     """``q`` of ``ring`` (see :func:`inflation_ratio_of`); 0 without gas. The inflated strain is
     q / (1 - q)."""
     if not ring.pressure:
@@ -88,12 +93,12 @@ def inflation_ratio(ring):
     )
 
 
-def inflated_radius(ring):
+def inflated_radius(ring: "Ring") -> float:
     """Radius (m) of the ring's inflated equilibrium circle, ``R / (1 - q)``; ``R`` without gas."""
     return ring.radius / (1.0 - inflation_ratio(ring))
 
 
-def initial_nodes(ring):
+def initial_nodes(ring: "Ring") -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Node positions (N, 2) m and velocities (N, 2) m/s: the inflated circle in rigid motion."""
     theta = 2.0 * np.pi * np.arange(ring.n_nodes) / ring.n_nodes
     offset = inflated_radius(ring) * np.stack([np.cos(theta), np.sin(theta)], axis=1)

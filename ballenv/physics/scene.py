@@ -7,8 +7,10 @@ the value and the valid range, e.g.::
 """
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from numbers import Integral, Real
+from typing import Any, NoReturn, TypeVar
 
 from .effects import scene_effects
 from .ring import burst_pressure
@@ -18,12 +20,23 @@ DAMPING_MODES = ("rigid", "centre_of_mass")
 CONTACT_METHODS = ("mass_modification", "predictor_corrector")
 SELF_INTERSECTION = ("reject", "ignore")
 
+T = TypeVar("T")
 
-def _fail(owner, name, value, valid):
+
+def _fail(owner: str, name: str, value: object, valid: str) -> NoReturn:
     raise ValueError(f"{owner}.{name} = {value!r} is out of range: must be {valid}")
 
 
-def check_real(owner, name, value, low, high, unit="", low_open=False, high_open=False):
+def check_real(
+    owner: str,
+    name: str,
+    value: object,
+    low: float,
+    high: float,
+    unit: str = "",
+    low_open: bool = False,
+    high_open: bool = False,
+) -> float:
     """Return ``value`` as float if it is a finite real within the interval, else raise ValueError."""
     lo_br = "(" if low_open else "["
     hi_br = ")" if high_open else "]"
@@ -38,14 +51,14 @@ def check_real(owner, name, value, low, high, unit="", low_open=False, high_open
     return v
 
 
-def check_int(owner, name, value, low, high):
+def check_int(owner: str, name: str, value: object, low: int, high: int) -> int:
     """Return ``value`` as int if it is an integer within [low, high], else raise ValueError."""
-    if isinstance(value, bool) or not isinstance(value, Integral) or not low <= value <= high:
+    if isinstance(value, bool) or not isinstance(value, Integral) or not low <= int(value) <= high:
         _fail(owner, name, value, f"an integer in [{low}, {high}]")
     return int(value)
 
 
-def check_vector(owner, name, value, bound, unit):
+def check_vector(owner: str, name: str, value: Any, bound: float, unit: str) -> tuple[float, ...]:
     """Return ``value`` as a tuple of two finite floats with magnitude at most ``bound``."""
     valid = f"a pair of finite numbers in [-{bound:g}, {bound:g}] {unit}"
     try:
@@ -65,7 +78,7 @@ def check_vector(owner, name, value, bound, unit):
     return tuple(out)
 
 
-def check_sequence(owner, name, value, cls, allow_empty):
+def check_sequence(owner: str, name: str, value: Any, cls: type[T], allow_empty: bool) -> tuple[T, ...]:
     """Return ``value`` (one ``cls`` or a sequence of them) as a tuple, else raise ValueError."""
     valid = f"a {'' if allow_empty else 'non-empty '}sequence of {cls.__name__}"
     items = (value,) if isinstance(value, cls) else value
@@ -78,7 +91,7 @@ def check_sequence(owner, name, value, cls, allow_empty):
     return items
 
 
-def check_choice(owner, name, value, choices):
+def check_choice(owner: str, name: str, value: object, choices: Sequence[str]) -> str:
     """Return ``value`` if it is one of ``choices`` (strings), else raise ValueError."""
     if not isinstance(value, str) or value not in choices:
         _fail(owner, name, value, "one of " + ", ".join(repr(c) for c in choices))
@@ -112,11 +125,11 @@ class Ring:
     width: float = 0.02
     density: float = 1100.0
     pressure: float | None = 30e3
-    position: tuple = (0.0, 1.0)
-    velocity: tuple = (0.0, 0.0)
+    position: tuple[float, float] = (0.0, 1.0)
+    velocity: tuple[float, float] = (0.0, 0.0)
     angular_velocity: float = 0.0
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         o = "Ring"
         s = object.__setattr__
         s(self, "radius", check_real(o, "radius", self.radius, 0.0, 100.0, "m", low_open=True))
@@ -165,7 +178,7 @@ class Ground:
     friction: float = 0.0
     x: float = 0.0
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         o = "Ground"
         s = object.__setattr__
         s(self, "angle", check_real(o, "angle", self.angle, -math.pi, math.pi, "rad"))
@@ -229,14 +242,14 @@ class Scene:
             SimulationError) or "ignore" (neither).
     """
 
-    rings: tuple = field(default_factory=lambda: (Ring(),))
-    grounds: tuple = ()
+    rings: Sequence[Ring] = field(default_factory=lambda: (Ring(),))
+    grounds: Sequence[Ground] = ()
     contact: str = "mass_modification"
     impulse_tol: float = 5e-3
     rtol: float = 0.0
     atol: float = 0.0
     friction_regularization: float = 1e-2
-    gravity: float | tuple = 9.81
+    gravity: float | tuple[float, float] = 9.81
     damping: float = 0.0
     damping_mode: str = "rigid"
     integrator: str = "generalized_alpha"
@@ -251,7 +264,7 @@ class Scene:
     ring_collision: bool = True
     self_intersection: str = "reject"
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         o = "Scene"
         s = object.__setattr__
         rings = check_sequence(o, "rings", self.rings, Ring, allow_empty=False)
@@ -298,14 +311,14 @@ class Scene:
         check_choice(o, "self_intersection", self.self_intersection, SELF_INTERSECTION)
 
     @property
-    def gravity_vector(self):
+    def gravity_vector(self) -> tuple[float, float]:
         """Gravitational acceleration (gx, gy) in m/s^2."""
         if isinstance(self.gravity, tuple):
             return self.gravity
         return (0.0, -self.gravity)
 
     @property
-    def effects(self):
+    def effects(self) -> tuple[str, ...]:
         """Names of the effects this scene switches on (stretching and bending always are), from the
         registry ``ballenv.physics.effects``."""
         return scene_effects(self)

@@ -1,10 +1,19 @@
 """simulate(scene, t_end) -> Trajectory: a :class:`~.simulation.Simulation` run once to its end."""
 
+from numpy.typing import ArrayLike
+
 from .scene import Scene, check_real
-from .simulation import Simulation, SimulationError
+from .simulation import Simulation, SimulationError, Trajectory
 
 
-def simulate(scene, t_end, x0=None, v0=None, output_dt=None, progress=False):
+def simulate(
+    scene: Scene,
+    t_end: float,
+    x0: ArrayLike | None = None,
+    v0: ArrayLike | None = None,
+    output_dt: float | None = None,
+    progress: bool = False,
+) -> Trajectory:
     """Simulate ``scene`` from t = 0 to ``t_end`` (s).
 
     Args:
@@ -28,5 +37,6 @@ def simulate(scene, t_end, x0=None, v0=None, output_dt=None, progress=False):
         output_dt = check_real("simulate", "output_dt", output_dt, 0.0, t_end, "s", low_open=True)
     sim = Simulation(scene, x0, v0, output_dt, expected_end=t_end, caller="simulate")
     if not sim.advance(t_end, progress):
+        assert sim.failure is not None  # advance() says why it stopped
         raise SimulationError(sim.failure, sim.trajectory())
     return sim.trajectory()

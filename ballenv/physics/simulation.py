@@ -8,12 +8,20 @@ that actuate between bounces drive one directly. :class:`SimulationStats` and :c
 are read off it.
 """
 
+from __future__ import annotations
+
 import math
+import os
+import pathlib
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from numbers import Integral
+from types import ModuleType
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from . import ring as ring_geometry
 from .actuation import apply_impulse, set_rest_pressure
@@ -52,9 +60,12 @@ from .layout import (
     STATUS_IMPULSE_AT_DT_MIN,
     STATUS_STEP_TOO_SMALL,
 )
-from .model import build_model, build_workspace, empty_recording, empty_state
+from .model import Model, Recording, Workspace, build_model, build_workspace, empty_recording, empty_state
 from .scene import Scene, check_real, check_vector
 from .stepper import advance, initial_state_values, record
+
+if TYPE_CHECKING:
+    from tqdm.auto import tqdm
 
 EVENT_ROWS_PER_RING = 64  # starting room of the event buffer (it grows)
 RECORDS = 1024  # starting room of the recording when every step is recorded (it grows)
@@ -67,7 +78,7 @@ class SimulationError(RuntimeError):
     ``trajectory`` holds everything accepted up to the failure.
     """
 
-    def __init__(self, message, trajectory=None):
+    def __init__(self, message: str, trajectory: Trajectory | None = None) -> None:
         super().__init__(message)
         self.trajectory = trajectory
 
@@ -90,9 +101,9 @@ class SimulationStats:
     rejected_steps: int
     newton_iterations: int
     wall_time: float
-    effects: tuple
+    effects: tuple[str, ...]
     integrator: str
-    rejections: dict = field(default_factory=dict)  # rejected steps by reason (layout.REJECTIONS)
+    rejections: dict[str, int] = field(default_factory=dict)  # rejected steps by reason (layout.REJECTIONS)
     energy_projected: int = 0
     energy_removed: float = 0.0
     collision_gain: float = 0.0
@@ -113,17 +124,17 @@ class Trajectory:
         scene: the simulated :class:`Scene`.
     """
 
-    t: np.ndarray
-    x: np.ndarray
-    v: np.ndarray
-    pressure: np.ndarray
-    contact_force: np.ndarray
-    events: list
+    t: NDArray[np.float64]
+    x: NDArray[np.float64]
+    v: NDArray[np.float64]
+    pressure: NDArray[np.float64]
+    contact_force: NDArray[np.float64]
+    events: list[tuple[float, int, str]]
     stats: SimulationStats
     scene: Scene = field(repr=False)
-    event_table: np.ndarray = field(default=None, repr=False)
+    event_table: NDArray[np.float64] | None = field(default=None, repr=False)
 
-    def apexes(self, ring=0):
+    def apexes(self, ring: int = 0) -> NDArray[np.float64]:
         """(k, 2) array of (t (s), centre-of-mass height (m)) at the apexes of ``ring``,
         interpolated inside the step (cubic Hermite), not sampled."""
         rows = self.event_table
@@ -132,11 +143,11 @@ class Trajectory:
         sel = (rows[:, EVENT_RING] == ring) & (rows[:, EVENT_KIND] == EVENT_APEX)
         return rows[sel][:, [EVENT_T, EVENT_HEIGHT]]
 
-    def centre_of_mass(self):
+    def centre_of_mass(self) -> NDArray[np.float64]:
         """(T, n_rings, 2) centre of mass (m); nodes of a ring have equal mass."""
         return self.x.mean(axis=2)
 
-    def energy(self):
+    def energy(self) -> dict[str, NDArray[np.float64]]:
         """Energy (J) per record and ring: dict of (T, n_rings) arrays.
 
         Keys: kinetic, stretching, bending, gas (the gas-law potential), gravity, total. Computed with
@@ -145,7 +156,7 @@ class Trajectory:
         """
         return energy(self.scene, self.x, self.v)
 
-    def save(self, path):
+    def save(self, path: str | os.PathLike[str]) -> pathlib.Path:
         """Write this trajectory to ``path`` (a compressed ``.npz``; layout in
         :mod:`ballenv.physics.trajectory_io`); returns the path written."""
         from .trajectory_io import save
@@ -153,14 +164,14 @@ class Trajectory:
         return save(self, path)
 
     @classmethod
-    def load(cls, path):
+    def load(cls, path: str | os.PathLike[str]) -> Trajectory:
         """A trajectory saved by :meth:`save`, exactly as it was (ValueError on a foreign file)."""
         from .trajectory_io import load
 
         return load(path)
 
 
-def energy(scene, x, v):
+def energy(scene: Scene, x: ArrayLike, v: ArrayLike) -> dict[str, NDArray[np.float64]]:
     """Mechanical plus gas energy (J) of states ``x, v`` (..., n_rings, n_nodes, 2); see Trajectory."""
     model = build_model(scene)
     x = np.asarray(x, dtype=float)
@@ -177,7 +188,7 @@ def energy(scene, x, v):
     return out
 
 
-def initial_state(scene):
+def initial_state(scene: Scene) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Node positions and velocities (R, N, 2) of the scene's rings at t = 0."""
     pairs = [ring_geometry.initial_nodes(r) for r in scene.rings]
     return np.stack([p[0] for p in pairs]), np.stack([p[1] for p in pairs])
@@ -203,8 +214,15 @@ class Simulation:
     """
 
     def __init__(
-        self, scene, x0=None, v0=None, output_dt=None, expected_end=None, effects=EFFECTS, caller="Simulation"
-    ):
+        self,
+        scene: Scene,
+        x0: ArrayLike | None = None,
+        v0: ArrayLike | None = None,
+        output_dt: float | None = None,
+        expected_end: float | None = None,
+        effects: Sequence[ModuleType] = EFFECTS,
+        caller: str = "Simulation",
+    ) -> None:
         if not isinstance(scene, Scene):
             raise ValueError(f"{caller}.scene = {scene!r} is invalid: must be a ballenv.physics.Scene")
         if output_dt is not None:
@@ -238,15 +256,15 @@ class Simulation:
         self.rec = empty_recording(capacity, n_rings, n_nodes, EVENT_ROWS_PER_RING * n_rings)
         record(self.model, 0, 0.0, self.state, self.rec)
         self.counters[COUNT_RECORDS] = 1
-        self.failure = None
+        self.failure: str | None = None
         self._wall = time.perf_counter() - start  # s: building, then advancing
 
     @property
-    def t(self):
+    def t(self) -> float:
         """Simulated time (s)."""
         return float(self.clock[CLOCK_T])
 
-    def advance(self, t, progress=False):
+    def advance(self, t: float, progress: bool = False) -> bool:
         """Step to time ``t`` (s; steps land on it); with ``progress`` a progress bar over simulated
         time. Returns True, or False when the run cannot go on: ``failure`` then says why (the
         state is the last accepted one). ValueError for a ``t`` before the simulated time."""
@@ -269,7 +287,7 @@ class Simulation:
         self._wall += time.perf_counter() - start
         return status == STATUS_DONE
 
-    def _advance_to(self, target, t_end):
+    def _advance_to(self, target: float, t_end: float) -> int:
         """Compiled steps until ``target`` (s), landing on ``t_end``; grows the recording when full."""
         while True:
             status = advance(
@@ -280,7 +298,7 @@ class Simulation:
                 return status
             self.rec = _grown(self.rec, self.counters)
 
-    def _failure_message(self, status):
+    def _failure_message(self, status: int) -> str:
         scene, t = self.scene, self.t
         if status == STATUS_IMPULSE_AT_DT_MIN and scene.rtol > 0.0:
             return (
@@ -303,23 +321,23 @@ class Simulation:
         )
 
     @property
-    def event_count(self):
+    def event_count(self) -> int:
         """Event rows recorded so far."""
         return int(self.counters[COUNT_EVENTS])
 
-    def event_rows(self, start=0):
+    def event_rows(self, start: int = 0) -> NDArray[np.float64]:
         """Event rows from ``start`` on: (t (s), ring, kind, centre-of-mass height (m))."""
         return self.rec.events[start : self.event_count].copy()
 
-    def _ring_index(self, owner, ring):
+    def _ring_index(self, owner: str, ring: object) -> int:
         n_rings = len(self.scene.rings)
-        if isinstance(ring, bool) or not isinstance(ring, Integral) or not 0 <= ring < n_rings:
+        if isinstance(ring, bool) or not isinstance(ring, Integral) or not 0 <= int(ring) < n_rings:
             raise ValueError(
                 f"{owner}.ring = {ring!r} is out of range: must be an integer in [0, {n_rings - 1}]"
             )
         return int(ring)
 
-    def set_rest_pressure(self, ring, pressure):
+    def set_rest_pressure(self, ring: int, pressure: float) -> None:
         """Set ring ``ring``'s gas to the amount whose gauge pressure at rest is ``pressure`` (Pa)
         (:func:`actuation.set_rest_pressure`), in the range ``Ring.pressure`` allows; the ring must
         hold gas."""
@@ -334,7 +352,7 @@ class Simulation:
         s = self.state
         set_rest_pressure(self.model, ring, pressure, s.x[ring], s.v[ring], s.energy[ring], self.ws)
 
-    def apply_impulse(self, ring, nodes, impulse):
+    def apply_impulse(self, ring: int, nodes: ArrayLike, impulse: tuple[float, float]) -> None:
         """Add momentum ``impulse`` (N s, a pair, each at most 1e3 N s) to ring ``ring``, shared
         equally by ``nodes`` (distinct node indices of the ring)."""
         owner = "Simulation.apply_impulse"
@@ -357,7 +375,7 @@ class Simulation:
             self.model, ring, s.x[ring], s.v[ring], s.energy[ring], self.ws, nodes, len(nodes), jx, jy
         )
 
-    def stats(self):
+    def stats(self) -> SimulationStats:
         """:class:`SimulationStats` so far."""
         c, clock = self.counters, self.clock
         return SimulationStats(
@@ -377,7 +395,7 @@ class Simulation:
             collision_gain=float(clock[CLOCK_COLLISION_GAIN]),
         )
 
-    def trajectory(self):
+    def trajectory(self) -> Trajectory:
         """The :class:`Trajectory` recorded so far (copies)."""
         rec = self.rec
         n_out = int(self.counters[COUNT_RECORDS])
@@ -395,7 +413,9 @@ class Simulation:
         )
 
 
-def _check_state(caller, name, value, shape):
+def _check_state(
+    caller: str, name: str, value: ArrayLike, shape: tuple[int, int, int]
+) -> NDArray[np.float64]:
     try:
         arr = np.asarray(value)
     except (TypeError, ValueError):  # ragged nesting
@@ -415,7 +435,7 @@ def _check_state(caller, name, value, shape):
     return arr.copy()
 
 
-def _check_ring_shapes(caller, scene, x):
+def _check_ring_shapes(caller: str, scene: Scene, x: NDArray[np.float64]) -> None:
     """Refuse starting node positions ``x`` (R, N, 2) m on which the wall's forces are undefined or
     the step cannot start: neighbouring nodes (almost) at the same place, nodes running clockwise
     (the gas would pull the wall inward), or, when the scene rejects such states, a self-crossing
@@ -443,7 +463,7 @@ def _check_ring_shapes(caller, scene, x):
             )
 
 
-def _grown(rec, counters):
+def _grown(rec: Recording, counters: NDArray[np.int64]) -> Recording:
     """A recording with room for more records and events, holding what ``rec`` has."""
     n_out = int(counters[COUNT_RECORDS])
     n_ev = int(counters[COUNT_EVENTS])
@@ -456,7 +476,7 @@ def _grown(rec, counters):
     return grown
 
 
-def _check_above_grounds(caller, grounds, x):
+def _check_above_grounds(caller: str, grounds: NDArray[np.float64], x: NDArray[np.float64]) -> None:
     for g, (nx, ny, d, _) in enumerate(grounds):
         phi = x[..., 0] * nx + x[..., 1] * ny - d
         if np.any(phi < 0.0):
@@ -467,7 +487,7 @@ def _check_above_grounds(caller, grounds, x):
             )
 
 
-def _check_apart(caller, model, x, ws):
+def _check_apart(caller: str, model: Model, x: NDArray[np.float64], ws: Workspace) -> None:
     count = find_contacts(x, model.thickness, ws.collision)
     inside = ws.collision.contacts[:count]
     inside = inside[inside[:, 5] < 0.0]
@@ -479,7 +499,7 @@ def _check_apart(caller, model, x, ws):
         )
 
 
-def progress_bar(t_end, start=0.0):
+def progress_bar(t_end: float, start: float = 0.0) -> tqdm[Any]:
     """A tqdm bar over simulated time (s) from ``start`` to ``t_end``; ``update`` it by the time
     advanced and ``close`` it."""
     from tqdm.auto import tqdm

@@ -25,22 +25,30 @@ key                 shape               dtype     content
 is rebuilt from ``event_table``. No pickled objects are stored (``allow_pickle=False`` on load).
 """
 
+from __future__ import annotations
+
 import dataclasses
 import json
+import os
 import pathlib
 import zipfile
+from collections.abc import Mapping
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .events import EVENT_KINDS, event_list
 from .scene import Ground, Ring, Scene
 
+if TYPE_CHECKING:
+    from .simulation import Trajectory
+
 FORMAT = "ballenv.trajectory"
 VERSION = 1
 ARRAYS = ("t", "x", "v", "pressure", "contact_force", "event_table")
 
 
-def scene_to_dict(scene):
+def scene_to_dict(scene: Scene) -> dict[str, Any]:
     """``scene`` as a JSON-ready dict (rings and grounds as lists of field dicts)."""
     out = {}
     for f in dataclasses.fields(scene):
@@ -53,7 +61,7 @@ def scene_to_dict(scene):
     return out
 
 
-def scene_from_dict(data):
+def scene_from_dict(data: Mapping[str, Any]) -> Scene:
     """The :class:`Scene` of a dict made by :func:`scene_to_dict` (values validated again)."""
     data = dict(data)
     rings = [Ring(**_tupled(r)) for r in data.pop("rings")]
@@ -63,11 +71,11 @@ def scene_from_dict(data):
     return Scene(rings=rings, grounds=grounds, **data)
 
 
-def _tupled(ring):
+def _tupled(ring: Mapping[str, Any]) -> dict[str, Any]:
     return {k: tuple(v) if isinstance(v, list) else v for k, v in ring.items()}
 
 
-def save(traj, path):
+def save(traj: Trajectory, path: str | os.PathLike[str]) -> pathlib.Path:
     """Write ``traj`` to ``path`` (``.npz`` is appended by NumPy if missing); returns the path."""
     path = pathlib.Path(path)
     if path.suffix != ".npz":
@@ -91,7 +99,7 @@ def save(traj, path):
     return path
 
 
-def load(path):
+def load(path: str | os.PathLike[str]) -> Trajectory:
     """Read a trajectory written by :func:`save`; a missing or foreign file raises ValueError
     (FileNotFoundError if it does not exist)."""
     from .simulation import SimulationStats, Trajectory

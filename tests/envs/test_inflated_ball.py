@@ -12,7 +12,7 @@ from gymnasium.utils.env_checker import check_env
 from gymnasium.wrappers import RenderCollection
 
 import ballenv  # noqa: F401  (registers the env)
-from ballenv.envs.inflated_ball import InflatedBallEnv
+from ballenv.envs.inflated_ball import InflatedBallEnv, ball_env
 from ballenv.envs.vector import InflatedBallVectorEnv
 
 MODES = ("pressure", "paddle")
@@ -210,3 +210,10 @@ def test_pressure_actions_move_the_energy_budget_and_reset_starts_a_new_one():
     env.reset(seed=4)
     assert energy[2] == energy[0] != raised
     assert np.all(env._batch.clocks[0, 2:] == 0.0)  # the run's energy tallies restart too
+
+
+def test_ball_env_finds_the_env_under_wrappers_and_refuses_other_envs():
+    env = RenderCollection(gym.make("InflatedBall-v1", render_mode="rgb_array"))
+    assert isinstance(ball_env(env), InflatedBallEnv) and ball_env(env) is env.unwrapped
+    with pytest.raises(TypeError, match="not an InflatedBall env"):
+        ball_env(gym.make("CartPole-v1"))

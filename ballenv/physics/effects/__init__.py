@@ -33,18 +33,24 @@ constraints and impulses in the step rather than as forces; ``CONSTRAINTS`` name
 ``Scene.effects``.
 """
 
-from collections.abc import Callable
-from typing import NamedTuple
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from types import ModuleType
+from typing import TYPE_CHECKING, NamedTuple
 
 from .. import collision, contact
 from . import bending, damping, gas, gravity, stretching
+
+if TYPE_CHECKING:
+    from ..scene import Scene
 
 EFFECTS = (stretching, bending, gas, gravity, damping)
 
 
 class Constraint(NamedTuple):
     name: str
-    enabled: Callable  # (scene) -> bool
+    enabled: Callable[[Scene], bool]
 
 
 CONSTRAINTS = (
@@ -54,7 +60,7 @@ CONSTRAINTS = (
 )
 
 
-def scene_effects(scene, effects=EFFECTS):
+def scene_effects(scene: Scene, effects: Sequence[ModuleType] = EFFECTS) -> tuple[str, ...]:
     """Names of the effects ``scene`` switches on, forces first, in registry order."""
     names = [e.NAME for e in effects if e.enabled(scene)]
     return tuple(names + [c.name for c in CONSTRAINTS if c.enabled(scene)])

@@ -9,10 +9,14 @@ neighbours on each side (band half-width 2 nodes), exact. Always on.
 """
 
 import math
+from typing import TYPE_CHECKING
 
 from ..cyclic import next_node, prev_node
 from ..jit import kernel
 from ..linalg import band_add_block
+
+if TYPE_CHECKING:
+    from ..scene import Scene
 
 NAME = "bending"
 ENERGY_PART = "bending"
@@ -20,7 +24,7 @@ LOW_RANK = 0
 PARAMETERS = ()
 
 
-def enabled(scene):
+def enabled(scene: "Scene") -> bool:
     """Every ring bends."""
     return True
 

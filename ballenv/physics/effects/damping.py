@@ -7,9 +7,14 @@ coupling through the centre of mass and spin is low-rank (2 or 3 columns). Dissi
 On when ``Scene.damping`` is not 0.
 """
 
+from typing import TYPE_CHECKING
+
 from ..geometry import rigid_motion
 from ..jit import kernel
 from ..linalg import band_add_block
+
+if TYPE_CHECKING:
+    from ..scene import Scene
 
 NAME = "damping"
 ENERGY_PART = None
@@ -21,7 +26,7 @@ DAMPING_RIGID = 1
 DAMPING_CENTRE_OF_MASS = 2
 
 
-def enabled(scene):
+def enabled(scene: "Scene") -> bool:
     """The scene's damping is not zero."""
     return scene.damping != 0.0
 

@@ -9,11 +9,15 @@ in O(N) by the Woodbury identity). On for rings with ``Ring.pressure`` set.
 """
 
 import math
+from typing import TYPE_CHECKING
 
 from ..cyclic import next_node, prev_node
 from ..geometry import polygon_area
 from ..jit import kernel
 from ..linalg import band_add_block
+
+if TYPE_CHECKING:
+    from ..scene import Scene
 
 NAME = "pressure"
 ENERGY_PART = "gas"
@@ -21,7 +25,7 @@ LOW_RANK = 1
 PARAMETERS = ()
 
 
-def enabled(scene):
+def enabled(scene: "Scene") -> bool:
     """Any ring holds gas."""
     return any(r.pressure is not None for r in scene.rings)
 

@@ -4,7 +4,12 @@
 ``Scene.gravity`` is not 0.
 """
 
+from typing import TYPE_CHECKING
+
 from ..jit import kernel
+
+if TYPE_CHECKING:
+    from ..scene import Scene
 
 NAME = "gravity"
 ENERGY_PART = "gravity"
@@ -12,7 +17,7 @@ LOW_RANK = 0
 PARAMETERS = ()
 
 
-def enabled(scene):
+def enabled(scene: "Scene") -> bool:
     """The scene's gravity is not zero."""
     return any(g != 0.0 for g in scene.gravity_vector)
 

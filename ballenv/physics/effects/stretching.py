@@ -9,10 +9,14 @@ exact. Always on.
 """
 
 import math
+from typing import TYPE_CHECKING
 
 from ..cyclic import next_node
 from ..jit import kernel
 from ..linalg import band_add_block
+
+if TYPE_CHECKING:
+    from ..scene import Scene
 
 NAME = "stretching"
 ENERGY_PART = "stretching"
@@ -20,7 +24,7 @@ LOW_RANK = 0
 PARAMETERS = ()
 
 
-def enabled(scene):
+def enabled(scene: "Scene") -> bool:
     """Every ring stretches."""
     return True
 
