@@ -258,6 +258,8 @@ def step_end(solver, clock, counters, t_end, output_dt):
     at_end = stop >= t_end - eps
     at_out = output_dt > 0.0 and abs(stop - next_out) <= eps
     at_grid = not solver.adaptive and abs(stop - grid) <= eps
+    if at_grid:  # on the grid itself: a clock summing steps of a non-binary dt drifts off it
+        stop = grid
     if at_end:
         stop = t_end
     return stop, at_end, at_out, at_grid

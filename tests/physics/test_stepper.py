@@ -113,3 +113,12 @@ def test_generalized_alpha_translating_ring_is_not_stopped_by_round_off_of_its_b
     energy = traj.energy()
     total = energy["total"][:, 0]
     assert np.max(total - total[0]) <= 1e-9 * energy["kinetic"][-1, 0]
+
+
+def test_fixed_steps_that_are_not_binary_fractions_stay_on_their_grid():
+    # 1.25e-5 s summed 10^4 times drifts past the grid tolerance: the clock must land on k dt
+    scene = Scene(rings=[Ring(position=(0.0, 0.6))], grounds=[Ground()], adaptive=False, dt=1.25e-5)
+    traj = simulate(scene, 0.15)
+    assert traj.t[-1] == pytest.approx(0.15)
+    assert traj.stats.steps == 12_000
+    assert np.allclose(np.diff(traj.t), 1.25e-5, rtol=1e-6, atol=0.0)
