@@ -123,6 +123,10 @@ BALLENV_SETTINGS = [
         "GA adaptive dt<=1e-3 tol=1e-4, rho_inf=0.3",
         dict(adaptive=True, dt=1e-3, impulse_tol=1e-4, rho_infinity=0.3),
     ),
+    *[
+        (f"GA adaptive dt<=1e-2 rtol={_tol(rtol)}", dict(adaptive=True, dt=1e-2, rtol=rtol))
+        for rtol in (1e-1, 3e-2, 1e-2, 3e-3, 1e-3)
+    ],
     *[(f"preset {name} (N={p['n_nodes']})", dict(fidelity=name)) for name, p in FIDELITY_PRESETS.items()],
 ]
 QUICK_BALLENV = ("GA fixed dt=2^-11", "GA adaptive dt<=1e-3 tol=1e-4", "preset balanced (N=64)")
