@@ -21,19 +21,17 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .extras import optional_module
+
 RGB = tuple[int, int, int]  # a colour, each channel 0-255
 
 
 def pillow() -> tuple[ModuleType, ModuleType, ModuleType]:
     """Pillow's ``Image``, ``ImageDraw`` and ``ImageFont``; without Pillow, an ImportError naming the
     extra to install."""
-    try:
-        from PIL import Image, ImageDraw, ImageFont
-    except ImportError as err:  # pragma: no cover - depends on the installed extras
-        raise ImportError(
-            "drawing needs Pillow: pip install 'ballenv[render]' (or pip install pillow)"
-        ) from err
-    return Image, ImageDraw, ImageFont
+    names = ("Image", "ImageDraw", "ImageFont")
+    image, draw, font = (optional_module(f"PIL.{name}", "drawing", "render", "pillow") for name in names)
+    return image, draw, font
 
 
 @dataclass(frozen=True)

@@ -21,6 +21,7 @@ from numpy.typing import NDArray
 
 from .draw import STYLE, Canvas, Style, View, pillow
 from .envs.batch import MODE_PADDLE, BallBatch, env_model
+from .extras import optional_module
 from .physics.effects.gas import ring_pressure
 
 if TYPE_CHECKING:
@@ -35,13 +36,7 @@ LINE_SPACING = 18  # pixels between the text lines
 
 
 def _pygame() -> ModuleType:
-    try:
-        import pygame
-    except ImportError as err:  # pragma: no cover - depends on the installed extras
-        raise ImportError(
-            "the human render mode needs pygame-ce: pip install 'ballenv[render]' (or pip install pygame-ce)"
-        ) from err
-    return pygame
+    return optional_module("pygame", "the human render mode", "render", "pygame-ce")
 
 
 class BallRenderer:

@@ -26,6 +26,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .draw import pillow
+from .extras import optional_module
 
 FORMATS = ("gif", "mp4")
 MP4_CRF = 20  # H.264 constant rate factor: 0 lossless, 23 x264's default, 51 worst
@@ -37,13 +38,7 @@ Path = str | os.PathLike[str]
 
 
 def _ffmpeg() -> ModuleType:
-    try:
-        import imageio_ffmpeg
-    except ImportError as err:  # pragma: no cover - depends on the installed extras
-        raise ImportError(
-            "MP4 video needs imageio-ffmpeg: pip install 'ballenv[render]' (or pip install imageio-ffmpeg)"
-        ) from err
-    return imageio_ffmpeg
+    return optional_module("imageio_ffmpeg", "MP4 video", "render", "imageio-ffmpeg")
 
 
 def video_format(path: Path) -> str:

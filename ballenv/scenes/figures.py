@@ -4,15 +4,13 @@ import math
 
 import numpy as np
 
+from ..extras import optional_module
+
 DPI = 80
 
 
 def _plt():
-    try:
-        import matplotlib
-    except ImportError as err:  # pragma: no cover - depends on the installed extras
-        raise ImportError("the scene figures need matplotlib: pip install 'ballenv[plot]'") from err
-    matplotlib.use("Agg")
+    optional_module("matplotlib", "the scene figures", "plot", "matplotlib").use("Agg")
     import matplotlib.pyplot as plt
 
     return plt
