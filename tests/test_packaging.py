@@ -1,8 +1,9 @@
 """The distribution: the wheel built from this source tree holds the licence, both packages with
-their data files, and console scripts that resolve to callables."""
+their data files, and console scripts that resolve to callables and run once it is installed."""
 
 import importlib
 import importlib.metadata
+import os
 import pathlib
 import shutil
 import subprocess
@@ -98,3 +99,27 @@ def test_the_console_scripts_resolve_and_answer_help(wheel, capsys):
             main(["--help"])
         assert stop.value.code == 0, name
         assert capsys.readouterr().out.startswith("usage:"), name
+
+
+def test_the_installed_wheel_runs_its_console_scripts_from_another_directory(wheel, tmp_path):
+    # installed with pip (its dependencies are this environment's), then run from a folder that is
+    # not the checkout: ballenv and agents must come from the installation, not from the source tree
+    target = tmp_path / "site"
+    install = [sys.executable, "-m", "pip", "install", "--no-deps", "-q", "--target", str(target)]
+    done = subprocess.run([*install, wheel.filename], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr[-3000:]
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    env = {**os.environ, "PYTHONPATH": str(target)}
+    where = "import ballenv, agents.train; print(ballenv.__file__); print(agents.train.__file__)"
+    found = subprocess.run(
+        [sys.executable, "-c", where], cwd=elsewhere, env=env, capture_output=True, text=True
+    )
+    assert found.returncode == 0, found.stderr[-3000:]
+    assert all(pathlib.Path(p).is_relative_to(target) for p in found.stdout.split()), found.stdout
+    for name in ("ballenv-train", "ballenv-evaluate", "ballenv-scenes", "ballenv-viewer"):
+        run = subprocess.run(
+            [target / "bin" / name, "--help"], cwd=elsewhere, env=env, capture_output=True, text=True
+        )
+        assert run.returncode == 0, (name, run.stderr[-3000:])
+        assert run.stdout.startswith("usage:"), name
