@@ -21,7 +21,7 @@ How a preset is made (SI units):
   times come out near those of a gas-filled sphere, ``pi sqrt(M / (2 pi r p))`` (a membrane
   flattening on the ground: contact force ``2 pi r p d`` at compression ``d``).
 * **wall** ``E`` and ``h``: the wall's thickness and an effective modulus of its carcass (rubber,
-  windings, panels), which sets how much the gas stretches it (a few %, 17 % for the tennis ball).
+  windings, panels), which sets how much the gas stretches it (8-17 %: ``p r cos(pi/N) / (E h)``).
 * **pressure**: the rule's, or a typical one where the rule leaves it open (stated per ball).
 * **damping** ``c`` (1/s, ``Scene.damping``): fitted by ``benchmarks/ball_calibration.py``
   (scipy's ``brentq``) so that the drop test's rebound is the middle of the rule's range, with the
@@ -254,15 +254,17 @@ def tennis_ball() -> Ball:
 
 def football() -> Ball:
     """FIFA Quality Pro size 5: circumference 69 cm (r = 10.98 cm), 432.5 g, 0.8 bar (the test's
-    pressure, inside the Laws of the Game's 0.6-1.1 atm); wall E = 20 MPa, h = 3 mm."""
+    pressure, inside the Laws of the Game's 0.6-1.1 atm); wall E = 20 MPa, h = 3 mm (inflated
+    strain 15 %)."""
     ring = regulation_ring(0.69 / (2 * math.pi), 0.4325, 80e3, 20e6, 3e-3, 0.69 / math.pi)
     return Ball("football", ring, FITTED_DAMPING["football"], FIFA_DROP, FIFA)
 
 
 def volleyball() -> Ball:
     """FIVB: circumference 66 cm (r = 10.50 cm), 270 g, 0.3125 kgf/cm^2 (30.6 kPa); wall E = 20 MPa,
-    h = 2 mm. The FIVB rules state no drop test: its damping is the football's (a bladder in
-    synthetic-leather panels too), and its drop from 2 m is a prediction, not a calibration."""
+    h = 2 mm (inflated strain 8 %). The FIVB rules state no drop test: its damping is the
+    football's (a bladder in synthetic-leather panels too), and its drop from 2 m is a prediction,
+    not a calibration."""
     ring = regulation_ring(0.66 / (2 * math.pi), 0.270, 0.3125 * 98066.5, 20e6, 2e-3, 0.66 / math.pi)
     return Ball("volleyball", ring, FITTED_DAMPING["football"], None, FIVB)
 
