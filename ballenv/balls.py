@@ -134,7 +134,8 @@ class DropResult:
         drop_height: height (m) of the ball's bottom at release.
         rebound: rebound height (m) measured as the test says (to the bottom or the top).
         impact_speed: speed (m/s) of the centre of mass at touchdown.
-        restitution: rebound over impact speed of the centre of mass, ``sqrt(apex fall / drop fall)``.
+        restitution: rebound over impact speed of the centre of mass, ``sqrt(rise / fall)`` of the
+            centre after and before touchdown.
         contact_time: touchdown to lift-off (s).
         peak_force: largest ground reaction (N), mean over ``PEAK_WINDOW`` windows.
         pressure: the ball's gauge pressure at rest (Pa).
