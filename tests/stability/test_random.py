@@ -27,22 +27,17 @@ def log_uniform(lo, hi):
 
 
 @st.composite
-def valid_scenes(draw, max_nodes=96, under_inflated=False):
+def valid_scenes(draw, max_nodes=96):
     """A random scene in the hard cases' ranges: one ring (or two) above a floor or a slope of up
     to 75 degrees, E 0.1 MPa-1 GPa, h/R 0.005-0.3, N 8-``max_nodes``, gauge pressure from none to
     40 % of the wall's bound (at most 10 bar), speeds up to 30 m/s, friction 0-2, any integrator,
-    contact method and step control. ``under_inflated``: gauge pressure below zero instead, down to
-    90 % of the atmosphere (or 40 % of the wall's bound), the gas law or a regulated pressure.
-    Returns (scene, t_end)."""
+    contact method and step control. Returns (scene, t_end)."""
     radius = draw(st.floats(0.05, 0.3))
     modulus = draw(log_uniform(1e5, 1e9))
     thickness = radius * draw(log_uniform(0.005, 0.3))
     width = draw(st.floats(0.005, 0.1))
     burst = 0.5 * modulus * thickness / radius
-    if under_inflated:
-        pressure = -draw(st.floats(0.0, min(0.9 * 101325.0, 0.4 * burst)))
-    else:
-        pressure = draw(st.one_of(st.none(), st.floats(0.0, min(1e6, 0.4 * burst))))
+    pressure = draw(st.one_of(st.none(), st.floats(0.0, min(1e6, 0.4 * burst))))
     angle = math.radians(draw(st.floats(-75.0, 75.0)))
     normal = np.array([-math.sin(angle), math.cos(angle)])
     tangent = np.array([normal[1], -normal[0]])
@@ -68,8 +63,8 @@ def valid_scenes(draw, max_nodes=96, under_inflated=False):
         rho_infinity=draw(st.floats(0.0, 1.0)),
         gravity=draw(st.floats(0.0, 20.0)),
         damping=draw(st.sampled_from([0.0, 5.0, 50.0])),
-        gas_exponent=draw(st.sampled_from([0.0, 1.0, 1.4] if under_inflated else [1.0, 1.4])),
-        atmospheric_pressure=101325.0 if under_inflated else draw(st.sampled_from([0.0, 101325.0])),
+        gas_exponent=draw(st.sampled_from([1.0, 1.4])),
+        atmospheric_pressure=draw(st.sampled_from([0.0, 101325.0])),
         adaptive=adaptive,
         dt=draw(log_uniform(1e-4, 1e-2)),
     )
@@ -81,16 +76,6 @@ def valid_scenes(draw, max_nodes=96, under_inflated=False):
 def test_random_valid_scenes_run_stable(case):
     """Finite, above ground, rings apart, t_end or a documented error; energy never above its start
     beyond round-off, with either integrator."""
-    scene, t_end = case
-    result = audit(scene, t_end)
-    assert result.problems() == [], (scene, result)
-
-
-@settings(max_examples=30, **SETTINGS)
-@given(valid_scenes(under_inflated=True))
-def test_random_under_inflated_and_regulated_scenes_run_stable(case):
-    """The same, for rings below the atmosphere's pressure (many buckle), with the gas law or a
-    regulated pressure."""
     scene, t_end = case
     result = audit(scene, t_end)
     assert result.problems() == [], (scene, result)
