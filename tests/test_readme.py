@@ -1,4 +1,5 @@
-"""Every code block of the README and of the docs' quick start is run or checked.
+"""Every code block of the README, of the docs' quick start and of the regulation balls' guide is run
+or checked.
 
 Python blocks run, in order, in one namespace per file (a later block may use an earlier one's
 names), in a temporary folder. Each command of a shell block is checked without running it:
@@ -17,7 +18,7 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-DOCUMENTS = ("README.md", "docs/quickstart.md")
+DOCUMENTS = ("README.md", "docs/quickstart.md", "docs/balls.md")
 PYTHON = {"python", "py"}
 SHELL = {"bash", "sh", "shell"}
 EXEMPT = {  # command -> why it is not checked

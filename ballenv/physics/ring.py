@@ -20,7 +20,9 @@ ball at rest reads). Per node, ``2 EA eps sin(pi/N) = p b r sin(2 pi/N)`` with `
     EA (r / R - 1) = p b r cos(pi / N)   =>   r = R / (1 - q),   q = p b R cos(pi / N) / EA
 
 (the hoop tension ``T = p b r`` of a thin pressurised ring, up to the polygon's ``cos(pi/N)``); ``q``
-must stay below 1 (beyond, no wall tension can hold the gas).
+must stay below 1 (beyond, no wall tension can hold the gas). A negative gauge pressure (an
+under-inflated ball, a ring under external pressure) gives ``q < 0``: the wall is compressed to
+``r < R`` by the hoop compression ``|p| b r``.
 """
 
 import math
@@ -75,6 +77,13 @@ def burst_pressure(radius: float, n_nodes: int, youngs_modulus: float, thickness
     ``q = 1/2`` and the inflated wall is stretched by 100 % (``q / (1 - q)``); ``Ring.pressure``'s
     upper bound."""
     return 0.5 * youngs_modulus * thickness / (radius * math.cos(math.pi / n_nodes))
+
+
+def crush_pressure(radius: float, n_nodes: int, youngs_modulus: float, thickness: float) -> float:
+    """The most negative gauge pressure (Pa) a ring may hold at rest: ``-E h / (R cos(pi / N))``,
+    where ``q = -1`` and the wall is compressed by 50 % (``r = R / 2``); ``Ring.pressure``'s lower
+    bound (the scene's atmosphere bounds it too: the absolute pressure stays positive)."""
+    return -2.0 * burst_pressure(radius, n_nodes, youngs_modulus, thickness)
 
 
 @kernel

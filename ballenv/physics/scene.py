@@ -13,7 +13,7 @@ from numbers import Integral, Real
 from typing import Any, NoReturn, TypeVar
 
 from .effects import scene_effects
-from .ring import burst_pressure
+from .ring import burst_pressure, crush_pressure
 
 INTEGRATORS = ("backward_euler", "generalized_alpha")
 DAMPING_MODES = ("rigid", "centre_of_mass")
@@ -91,6 +91,25 @@ def check_sequence(owner: str, name: str, value: Any, cls: type[T], allow_empty:
     return items
 
 
+def check_gauge_pressure(
+    owner: str, name: str, value: object, ring: "Ring", atmospheric_pressure: float | None = None
+) -> float:
+    """Return ``value`` (a gauge pressure at rest, Pa) as float if ``ring``'s wall holds it, else raise
+    ValueError: at most ``min(1e8, burst_pressure)`` (the wall stretched by 100 %), at least
+    ``max(-1e8, crush_pressure)`` (the wall compressed by 50 %); with ``atmospheric_pressure`` given,
+    a negative value must also keep the absolute pressure ``p + p_atm`` positive (so none without
+    an atmosphere)."""
+    geometry = (ring.radius, ring.n_nodes, ring.youngs_modulus, ring.thickness)
+    high = min(1e8, burst_pressure(*geometry))
+    low = max(-1e8, crush_pressure(*geometry))
+    unit = "Pa; the bounds compress the wall by 50 % and stretch it by 100 %"
+    low_open = False
+    if atmospheric_pressure is not None and -atmospheric_pressure >= low:
+        low, low_open = (-atmospheric_pressure, True) if atmospheric_pressure > 0.0 else (0.0, False)
+        unit = "Pa; the absolute pressure p + Scene.atmospheric_pressure must stay positive"
+    return check_real(owner, name, value, low, high, unit, low_open=low_open)
+
+
 def check_choice(owner: str, name: str, value: object, choices: Sequence[str]) -> str:
     """Return ``value`` if it is one of ``choices`` (strings), else raise ValueError."""
     if not isinstance(value, str) or value not in choices:
@@ -109,10 +128,14 @@ class Ring:
         thickness: wall thickness h (m), in (0, radius).
         width: out-of-plane width b (m), in (0, 100].
         density: wall density rho (kg/m^3), in (0, 1e5].
-        pressure: gauge pressure (Pa) of the inflated ball at rest, in [0, min(1e8, E h / (2 R cos(pi/N)))],
-            or None for no gas at all. The ring starts inflated to the circle where its wall tension
-            holds this pressure (radius ``R / (1 - p b R cos(pi/N) / EA)``); the amount of gas is fixed
-            there and the gas law sets the pressure as the ring deforms.
+        pressure: gauge pressure (Pa) of the inflated ball at rest, in
+            [max(-1e8, -E h / (R cos(pi/N))), min(1e8, E h / (2 R cos(pi/N)))] (the wall compressed by
+            50 %, stretched by 100 %), or None for no gas at all. Negative: an under-inflated ball or
+            a ring under external pressure; the scene then asks that the absolute pressure
+            ``pressure + Scene.atmospheric_pressure`` be positive. The ring starts at the circle where
+            its wall tension holds this pressure (radius ``R / (1 - p b R cos(pi/N) / EA)``); the amount
+            of gas is fixed there and the gas law sets the pressure as the ring deforms (or, with
+            ``Scene.gas_exponent`` 0, a regulator holds it).
         position: initial centre (m).
         velocity: initial centre velocity (m/s), each component in [-1000, 1000].
         angular_velocity: initial spin (rad/s, counter-clockwise), in [-1e5, 1e5].
@@ -147,10 +170,8 @@ class Ring:
         s(self, "width", check_real(o, "width", self.width, 0.0, 100.0, "m", low_open=True))
         s(self, "density", check_real(o, "density", self.density, 0.0, 1e5, "kg/m^3", True))
         if self.pressure is not None:
-            # inflated strain q / (1 - q) with q = p R cos(pi/N) / (E h): at most 100 % (q <= 1/2)
-            burst = burst_pressure(self.radius, self.n_nodes, self.youngs_modulus, self.thickness)
-            unit = "Pa (or None); the upper bound inflates the wall by 100 %"
-            s(self, "pressure", check_real(o, "pressure", self.pressure, 0.0, min(1e8, burst), unit))
+            # inflated strain q / (1 - q) with q = p R cos(pi/N) / (E h): in [-50 %, 100 %]
+            s(self, "pressure", check_gauge_pressure(o, "pressure", self.pressure, self))
         s(self, "position", check_vector(o, "position", self.position, 1e6, "m"))
         s(self, "velocity", check_vector(o, "velocity", self.velocity, 1e3, "m/s"))
         s(
@@ -232,7 +253,9 @@ class Scene:
             (dimensionless), in [1e-14, 1e-2].
         newton_max_iter: Newton iterations before the step is rejected, in [1, 200].
         atmospheric_pressure: p_atm (Pa) in [0, 1e7]; 0 gives the paper's ``p A = const``.
-        gas_exponent: k in ``(p + p_atm) A^k = const`` in [1, 3] (1 isothermal, 1.4 adiabatic air).
+        gas_exponent: k in ``(p + p_atm) A^k = const`` in [0, 3] (1 isothermal, 1.4 adiabatic air;
+            0 a regulated pressure: each ring's gauge pressure stays at its set value whatever its
+            area, a line load ``p b`` with the potential ``-b p A``).
         ring_collision: rings push each other apart when a node comes within the contact distance
             ``h_a + h_b`` of another ring's centreline (``collision.py``); only with two or more
             rings. False lets rings pass through each other.
@@ -305,7 +328,11 @@ class Scene:
             "atmospheric_pressure",
             check_real(o, "atmospheric_pressure", self.atmospheric_pressure, 0.0, 1e7, "Pa"),
         )
-        s(self, "gas_exponent", check_real(o, "gas_exponent", self.gas_exponent, 1.0, 3.0))
+        s(self, "gas_exponent", check_real(o, "gas_exponent", self.gas_exponent, 0.0, 3.0))
+        p_atm = self.atmospheric_pressure
+        for i, ring in enumerate(rings):
+            if ring.pressure is not None and ring.pressure < 0.0:
+                check_gauge_pressure(o, f"rings[{i}].pressure", ring.pressure, ring, p_atm)
         if not isinstance(self.ring_collision, bool):
             _fail(o, "ring_collision", self.ring_collision, "True or False")
         check_choice(o, "self_intersection", self.self_intersection, SELF_INTERSECTION)

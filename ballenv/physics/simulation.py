@@ -10,7 +10,6 @@ are read off it.
 
 from __future__ import annotations
 
-import math
 import os
 import pathlib
 import time
@@ -61,7 +60,7 @@ from .layout import (
     STATUS_STEP_TOO_SMALL,
 )
 from .model import Model, Recording, Workspace, build_model, build_workspace, empty_recording, empty_state
-from .scene import Scene, check_real, check_vector
+from .scene import Scene, check_gauge_pressure, check_real, check_vector
 from .stepper import advance, initial_state_values, record
 
 if TYPE_CHECKING:
@@ -339,16 +338,14 @@ class Simulation:
 
     def set_rest_pressure(self, ring: int, pressure: float) -> None:
         """Set ring ``ring``'s gas to the amount whose gauge pressure at rest is ``pressure`` (Pa)
-        (:func:`actuation.set_rest_pressure`), in the range ``Ring.pressure`` allows; the ring must
-        hold gas."""
+        (:func:`actuation.set_rest_pressure`), in the range ``Ring.pressure`` and the scene's atmosphere
+        allow (:func:`scene.check_gauge_pressure`); the ring must hold gas."""
         owner = "Simulation.set_rest_pressure"
         ring = self._ring_index(owner, ring)
         spec = self.scene.rings[ring]
         if spec.pressure is None:
             raise ValueError(f"{owner}: ring {ring} holds no gas (Ring.pressure None)")
-        burst = 0.5 * spec.youngs_modulus * spec.thickness / (spec.radius * math.cos(math.pi / spec.n_nodes))
-        unit = "Pa; the upper bound inflates the wall by 100 %"
-        pressure = check_real(owner, "pressure", pressure, 0.0, min(1e8, burst), unit)
+        pressure = check_gauge_pressure(owner, "pressure", pressure, spec, self.scene.atmospheric_pressure)
         s = self.state
         set_rest_pressure(self.model, ring, pressure, s.x[ring], s.v[ring], s.energy[ring], self.ws)
 

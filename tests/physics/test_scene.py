@@ -20,7 +20,7 @@ from ballenv.physics import Ring, Scene, simulate
         ({"radius": math.inf}, "radius"),
         ({"density": -5.0}, "density"),
         ({"width": 0.0}, "width"),
-        ({"pressure": -1.0}, "pressure"),
+        ({"pressure": -2.1e5}, "pressure"),  # -E h / (R cos(pi/N)) compresses the wall by 50 %
         ({"pressure": math.nan}, "pressure"),
         ({"pressure": 1.1e5}, "pressure"),  # E h / (2 R) = 1e5 Pa would stretch the wall by 100 %
         ({"position": (0.0, math.nan)}, "position"),
@@ -52,12 +52,25 @@ def test_ring_rejects_invalid_values(kwargs, field):
         ({"newton_tol": 0.5}, "newton_tol"),
         ({"newton_max_iter": 0}, "newton_max_iter"),
         ({"atmospheric_pressure": -1.0}, "atmospheric_pressure"),
-        ({"gas_exponent": 0.5}, "gas_exponent"),
+        ({"gas_exponent": -0.5}, "gas_exponent"),
+        ({"gas_exponent": 3.5}, "gas_exponent"),
+        ({"rings": [Ring(pressure=-1.5e5)]}, r"rings\[0\]\.pressure"),
+        ({"rings": [Ring(), Ring(pressure=-1.0)], "atmospheric_pressure": 0.0}, r"rings\[1\]\.pressure"),
     ],
 )
 def test_scene_rejects_invalid_values(kwargs, field):
     with pytest.raises(ValueError, match=rf"Scene\.{field} = .* must be"):
         Scene(**kwargs)
+
+
+def test_negative_gauge_pressure_keeps_the_absolute_pressure_positive():
+    assert Scene(rings=[Ring(pressure=-101e3)]).rings[0].pressure == -101e3
+    with pytest.raises(ValueError) as err:
+        Scene(rings=[Ring(pressure=-2e4)], atmospheric_pressure=1e4)
+    assert str(err.value) == (
+        "Scene.rings[0].pressure = -20000.0 is out of range: must be a finite number in (-10000, 100121]"
+        " Pa; the absolute pressure p + Scene.atmospheric_pressure must stay positive"
+    )
 
 
 def test_error_message_names_value_and_range():

@@ -151,7 +151,7 @@ RING_FIELDS = {
     "width": open_low(0.0, 100.0),
     "density": open_low(0.0, 1e5),
     "pressure": st.one_of(
-        st.floats(max_value=0.0, exclude_max=True),
+        st.floats(max_value=-2.01e5),  # below -E h / (R cos(pi/N)): the wall compressed by 50 %
         st.floats(1e5 + 1.0, 1e30),
         NOT_A_NUMBER.filter(lambda v: v is not None),
     ),  # fmt: skip
@@ -192,7 +192,7 @@ SCENE_FIELDS = {
     "newton_tol": out_of(1e-14, 1e-2),
     "newton_max_iter": out_of(1, 200, integer=True),
     "atmospheric_pressure": out_of(0.0, 1e7),
-    "gas_exponent": out_of(1.0, 3.0),
+    "gas_exponent": out_of(0.0, 3.0),
     "ring_collision": NOT_A_BOOL,
     "self_intersection": bad_choice(("reject", "ignore")),
 }

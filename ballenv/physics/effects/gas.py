@@ -2,7 +2,10 @@
 
 The ring holds an amount of gas with ``(p + p_atm) A^k = C`` (``C`` = ``Model.gas_constant``,
 Pa m^(2k); ``k`` = ``Model.gas_exponent``, 1 isothermal, 1.4 adiabatic; ``p_atm`` Pa): gauge
-pressure ``p`` (Pa) at polygon area ``A`` (m^2). Its line load ``p b`` on each edge is, exactly,
+pressure ``p`` (Pa) at polygon area ``A`` (m^2). The gauge pressure may be negative (an
+under-inflated ball, a ring under external pressure) as long as the absolute pressure ``p + p_atm``
+is positive. ``k = 0`` is a regulated pressure: ``p = C - p_atm`` whatever the area, no gas
+stiffness (``dp/dA = 0``), potential ``U = -b p A``. Its line load ``p b`` on each edge is, exactly,
 ``F_i = p b dA/dx_i`` (N), the gradient of the potential ``U = -b int p dA`` (J). The Jacobian
 ``b (p hess A + dp/dA grad A grad A^T)`` is a band part plus one low-rank column (kept exact, solved
 in O(N) by the Woodbury identity). On for rings with ``Ring.pressure`` set.

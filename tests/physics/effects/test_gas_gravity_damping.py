@@ -41,11 +41,12 @@ def test_polygon_area_of_square():
     assert polygon_area(x[::-1].copy()) == pytest.approx(-6.0)
 
 
-@pytest.mark.parametrize("k", [1.0, 1.4])
+@pytest.mark.parametrize("gauge", [30e3, -40e3])
+@pytest.mark.parametrize("k", [0.0, 1.0, 1.4])
 @pytest.mark.parametrize("n_nodes", [5, 64])
-def test_pressure_force_is_minus_gas_energy_gradient(k, n_nodes):
+def test_pressure_force_is_minus_gas_energy_gradient(k, n_nodes, gauge):
     x = deformed_ring(n_nodes)
-    c = _gas_constant(x, 30e3, k) * 1.1
+    c = _gas_constant(x, gauge, k) * 1.1
 
     def force(y):
         f = np.zeros_like(y)
@@ -56,11 +57,12 @@ def test_pressure_force_is_minus_gas_energy_gradient(k, n_nodes):
     assert relative_error(force(x), -grad) < 1e-6
 
 
-@pytest.mark.parametrize("k", [1.0, 1.4])
+@pytest.mark.parametrize("gauge", [30e3, -40e3])
+@pytest.mark.parametrize("k", [0.0, 1.0, 1.4])
 @pytest.mark.parametrize("n_nodes", [3, 8, 64])
-def test_pressure_jacobian_with_gas_law_matches_finite_differences(k, n_nodes):
+def test_pressure_jacobian_with_gas_law_matches_finite_differences(k, n_nodes, gauge):
     x = deformed_ring(n_nodes, seed=3)
-    c = _gas_constant(x, 30e3, k) * 1.2
+    c = _gas_constant(x, gauge, k) * 1.2
 
     def force(y):
         f = np.zeros_like(y)
@@ -91,6 +93,16 @@ def test_gas_law_slope_matches_finite_difference():
     slope = gas_pressure_slope(area, c, k)
     fd = (gas_pressure(area + 1e-9, c, k, P_ATM) - gas_pressure(area - 1e-9, c, k, P_ATM)) / 2e-9
     assert slope == pytest.approx(fd, rel=1e-6)
+
+
+@pytest.mark.parametrize("gauge", [30e3, -40e3])
+def test_regulated_pressure_holds_its_value_whatever_the_area(gauge):
+    """``k = 0``: ``p + p_atm = C`` at any area, no stiffness from the gas, potential ``-b p A``."""
+    c = gauge + P_ATM
+    for area in (0.01, 0.03, 0.05):
+        assert gas_pressure(area, c, 0.0, P_ATM) == pytest.approx(gauge, rel=1e-12)
+        assert gas_pressure_slope(area, c, 0.0) == 0.0
+        assert gas_energy(area, c, 0.0, P_ATM, WIDTH) == pytest.approx(-WIDTH * gauge * area, rel=1e-9)
 
 
 def test_gravity_force_and_energy():
