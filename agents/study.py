@@ -8,7 +8,8 @@ episodes, interquartile mean (IQM) with bootstrap confidence intervals, learning
 
 Each seed trains with ``agents.train`` into ``{out}/{algo}_{mode}_seed{k}`` (a folder that already
 holds ``scores.json`` is reused, so an interrupted study resumes); its best model is scored on the
-held-out episodes (seeds 10,000 on), and so are the tuned heuristic and random actions. Writes
+held-out episodes (seeds 10,000 on), and so are the tuned heuristic and random actions. A later
+study with more ``--episodes`` scores the trained models again, without training them. Writes
 ``{out}/{algo}_{mode}.md`` (the table) and ``{out}/{algo}_{mode}.png`` (learning curves, the
 baselines as lines).
 
@@ -26,6 +27,7 @@ import argparse
 import json
 import pathlib
 from collections.abc import Sequence
+from dataclasses import asdict
 from typing import Any
 
 import numpy as np
@@ -101,6 +103,21 @@ def train_seed(args: argparse.Namespace, seed: int) -> pathlib.Path:
     return train(parse_args(argv))
 
 
+def heldout_score(args: argparse.Namespace, run: pathlib.Path, env_kwargs: dict[str, Any]) -> Score:
+    """The best model of ``run`` on ``args.episodes`` held-out episodes: the training's final
+    evaluation (``scores.json``) if it has that many, else a new one kept in ``heldout_{n}.json``
+    (the same episodes, seeds 10,000 on: a longer evaluation extends the shorter one)."""
+    stored = Score(**json.loads((run / "scores.json").read_text())[0])
+    if stored.episodes == args.episodes:
+        return stored
+    path = run / f"heldout_{args.episodes}.json"
+    if not path.exists():
+        score = evaluate(run, env_kwargs, args.episodes, algo=args.algo, progress=True)
+        score = Score(**{**asdict(score), "policy": stored.policy})
+        path.write_text(json.dumps(asdict(score), indent=2))
+    return Score(**json.loads(path.read_text()))
+
+
 def plot(
     path: pathlib.Path, runs: Sequence[pathlib.Path], baselines: Sequence[dict[str, Any]], title: str
 ) -> None:
@@ -148,8 +165,8 @@ def main(argv: Sequence[str] | None = None) -> None:
     if args.env_kwargs:
         args.train_args += ["--env-kwargs", json.dumps(args.env_kwargs)]
     runs = [train_seed(args, seed) for seed in args.seeds]
-    trained = [Score(**json.loads((r / "scores.json").read_text())[0]) for r in runs]
     mode = {**args.env_kwargs, "action_mode": args.action_mode}
+    trained = [heldout_score(args, run, mode) for run in runs]
     baselines = [
         summarise(name, [evaluate(name, mode, args.episodes, progress=True)])
         for name in ("heuristic", "random")

@@ -48,3 +48,12 @@ def test_a_tiny_study_runs_end_to_end(tmp_path, capsys):
     main(argv)  # resumes: the trained seeds are reused, not trained again
     assert (tmp_path / "ppo_pressure_seed0" / "scores.json").stat().st_mtime == mtime
     assert not (tmp_path / "ppo_pressure_seed0_2").exists()
+    argv[argv.index("--episodes") + 1] = "3"
+    main(argv)  # more held-out episodes: the trained models are scored again, not trained again
+    assert (tmp_path / "ppo_pressure_seed0" / "scores.json").stat().st_mtime == mtime
+    stored = json.loads((tmp_path / "ppo_pressure_seed0" / "scores.json").read_text())[0]
+    longer = json.loads((tmp_path / "ppo_pressure_seed0" / "heldout_3.json").read_text())
+    assert longer["episodes"] == 3 and longer["policy"] == stored["policy"]
+    assert longer["episode_apex_errors"][:2] == stored["episode_apex_errors"]  # the same first episodes
+    rows = json.loads((tmp_path / "ppo_pressure.json").read_text())
+    assert rows[0]["episodes"] == 6 and rows[1]["episodes"] == 3
