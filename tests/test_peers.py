@@ -1,28 +1,14 @@
 """The peer benchmark (benchmarks/peers.py) in reduced form: ballenv's side of the 1-s drop against
 the stored reference apex, PyElastica's side when pyelastica is installed (``ballenv[peers]``)."""
 
-import importlib.util
 import math
-import pathlib
-import sys
 
 import numpy as np
 import pytest
 
-BENCHMARK = pathlib.Path(__file__).resolve().parents[1] / "benchmarks" / "peers.py"
+from .benchmark_modules import load_benchmark
 
-
-def _load_benchmark():
-    if "peers" in sys.modules:
-        return sys.modules["peers"]
-    spec = importlib.util.spec_from_file_location("peers", BENCHMARK)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules["peers"] = module  # dataclasses look their module up here
-    spec.loader.exec_module(module)
-    return module
-
-
-peers = _load_benchmark()
+peers = load_benchmark("peers")
 
 
 def test_every_named_setting_is_a_valid_scene():

@@ -1,27 +1,12 @@
 """The work-precision benchmark (benchmarks/work_precision.py) in reduced form: convergence orders of
 both integrators in flight, and a few points of the single-bounce sweep against its reference."""
 
-import importlib.util
-import pathlib
-import sys
-
 import numpy as np
 import pytest
 
-BENCHMARK = pathlib.Path(__file__).resolve().parents[2] / "benchmarks" / "work_precision.py"
+from ..benchmark_modules import load_benchmark
 
-
-def _load_benchmark():
-    if "work_precision" in sys.modules:
-        return sys.modules["work_precision"]
-    spec = importlib.util.spec_from_file_location("work_precision", BENCHMARK)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules["work_precision"] = module  # dataclasses look their module up here
-    spec.loader.exec_module(module)
-    return module
-
-
-wp = _load_benchmark()
+wp = load_benchmark("work_precision")
 FLIGHT_DTS = np.array([1e-4, 5e-5, 2.5e-5, 1.25e-5])
 
 

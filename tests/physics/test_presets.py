@@ -5,6 +5,8 @@ import pytest
 from ballenv.physics import Ground, Ring, Scene
 from ballenv.physics.presets import FIDELITY_PRESETS, with_fidelity
 
+from ..benchmark_modules import load_benchmark
+
 
 @pytest.mark.parametrize("name", sorted(FIDELITY_PRESETS))
 def test_preset_sets_the_numerics_and_keeps_the_physics(name):
@@ -31,17 +33,7 @@ README_APEX_ERROR_BOUNDS = {"fast": 0.05, "balanced": 0.005, "accurate": 0.003}
 
 
 def _work_precision():
-    import importlib.util
-    import pathlib
-    import sys
-
-    if "work_precision" not in sys.modules:
-        path = pathlib.Path(__file__).resolve().parents[2] / "benchmarks" / "work_precision.py"
-        spec = importlib.util.spec_from_file_location("work_precision", path)
-        module = importlib.util.module_from_spec(spec)
-        sys.modules["work_precision"] = module  # dataclasses look their module up here
-        spec.loader.exec_module(module)
-    return sys.modules["work_precision"]
+    return load_benchmark("work_precision")
 
 
 @pytest.fixture(scope="module")
