@@ -208,3 +208,23 @@ def test_a_thin_walled_empty_ring_dropped_at_15_m_s_completes(thickness):
     assert not any(self_intersects(xk[0]) for xk in traj.x)
     energy = traj.energy()["total"][:, 0]
     assert energy.max() <= energy[0] * (1 + 1e-9)  # the barrier is a potential: no energy made
+
+
+def test_the_rolling_rings_of_figure_8_complete_with_walls_of_2_5_mm():
+    # the scene library's rolling rings (figure 8) with the intended wall, h = 2.5 mm instead of
+    # 5 mm: the two softest sag until top meets bottom and roll folded
+    slope, radius = 0.15, 0.1
+    normal = np.array([-np.sin(slope), np.cos(slope)])
+    heights = []
+    for modulus in (2e6, 4e6, 6e6, 8e6):
+        centre = tuple((radius + 0.003) * normal)
+        ring = Ring(radius=radius, thickness=2.5e-3, youngs_modulus=modulus, pressure=None, position=centre)
+        scene = Scene(rings=[ring], grounds=[Ground(angle=slope, friction=0.8)], damping=20.0, dt=1e-2,
+                      adaptive=True, impulse_tol=2e-3, newton_tol=1e-9, rho_infinity=0.3)  # fmt: skip
+        traj = simulate(scene, 2.0, output_dt=5e-3)
+        assert traj.t[-1] == pytest.approx(2.0)
+        assert not any(self_intersects(xk[0]) for xk in traj.x)
+        up = traj.x[:, 0] @ normal
+        heights.append(np.mean(up.max(axis=1)[-100:] - up.min(axis=1)[-100:]))
+    assert np.all(np.diff(heights) > 0.0)  # the rolling shape is taller the stiffer the wall
+    assert heights[0] < 0.3 * 2 * radius  # the softest rolls folded
