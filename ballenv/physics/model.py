@@ -88,7 +88,7 @@ class BarrierWorkspace(NamedTuple):
     """Scratch of a ring's self-contact barrier (``barrier.py``) for rings of N nodes."""
 
     pairs: np.ndarray  # (PAIRS_PER_NODE N, 2) int64: candidate (node, edge) pairs
-    count: np.ndarray  # (1,) int64: how many of them the Newton iteration uses
+    n_pairs: np.ndarray  # (1,) int64: how many of them the Newton iteration uses
     mode: np.ndarray  # (1,) int64: newton.PLAIN (no barrier) or newton.SAFE
     active0: np.ndarray  # (N,) int64: the contact set at the step's start
     order: np.ndarray  # (N,) int64: edges by the left edge of their box
@@ -278,7 +278,7 @@ def build_barrier_workspace(n_nodes):
     k = MAX_LOW_RANK + n2
     return BarrierWorkspace(
         pairs=np.zeros((PAIRS_PER_NODE * n_nodes, 2), dtype=np.int64),
-        count=np.zeros(1, dtype=np.int64),
+        n_pairs=np.zeros(1, dtype=np.int64),
         mode=np.zeros(1, dtype=np.int64),
         active0=np.zeros(n_nodes, dtype=np.int64),
         order=np.arange(n_nodes, dtype=np.int64),

@@ -101,9 +101,9 @@ def correction(model, solver, r, x0, h, ws, active):
     rank = ring_jacobian(model, r, ws.xe, ws.ve, c_mass, c_x, c_v, ws)
     bw = ws.barrier
     wide = rank
-    if model.self_barrier and bw.mode[0] == SAFE and bw.count[0] > 0:
+    if model.self_barrier and bw.mode[0] == SAFE and bw.n_pairs[0] > 0:
         wide = barrier_jacobian(
-            ws.xe, bw.pairs, bw.count[0], stiffness(model, r), reach(model, r), c_x, ws.band, ws.pos,
+            ws.xe, bw.pairs, bw.n_pairs[0], stiffness(model, r), reach(model, r), c_x, ws.band, ws.pos,
             bw.u, bw.w, rank, bw,
         )  # fmt: skip
     if model.contact_method != CONTACT_NONE:
@@ -169,10 +169,10 @@ def barrier_filter(model, r, c_x, ws, res):
 
 @kernel(inline="always")
 def _cut_at_impact(model, r, xa, bw):
-    """Candidate pairs over the motion ``xa -> bw.xn`` into ``bw.pairs``, ``bw.count``; the fraction
+    """Candidate pairs over the motion ``xa -> bw.xn`` into ``bw.pairs``, ``bw.n_pairs``; the fraction
     of the motion before the first impact (``CCD_SAFETY`` of it, or 1), -1 if they do not fit."""
     count = find_pairs(xa, bw.xn, model.rest_len[r], reach(model, r), bw)
-    bw.count[0] = max(count, 0)
+    bw.n_pairs[0] = max(count, 0)
     if count < 0:
         return -1.0
     if count == 0:
@@ -186,8 +186,8 @@ def add_barrier_force(model, r, ws):
     """In safe mode, add the self-contact barrier's force at the force evaluation point ``ws.xe``
     (on the candidate pairs of the last correction's motion) to ``ws.force``."""
     bw = ws.barrier
-    if bw.mode[0] == SAFE and bw.count[0] > 0:
-        barrier_force(ws.xe, bw.pairs, bw.count[0], stiffness(model, r), reach(model, r), ws.force, bw)
+    if bw.mode[0] == SAFE and bw.n_pairs[0] > 0:
+        barrier_force(ws.xe, bw.pairs, bw.n_pairs[0], stiffness(model, r), reach(model, r), ws.force, bw)
 
 
 @kernel
