@@ -38,7 +38,9 @@ def free_energy(model, r, x, v, ws, out):
 @kernel
 def self_contact_energy(model, r, x, bw):
     """The self-contact barrier's energy (J) of ring ``r`` at nodes ``x``: 0 without a pair within
-    ``dhat`` (then exactly nothing is added)."""
+    ``dhat`` (then exactly nothing is added), or without the barrier's workspace (``bw`` None)."""
+    if bw is None:
+        return 0.0
     count = find_pairs(x, x, model.rest_len[r], reach(model, r), bw)
     if count == 0:
         return 0.0

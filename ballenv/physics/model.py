@@ -126,7 +126,7 @@ class Workspace(NamedTuple):
     energy: np.ndarray  # (P,) energy parts (J), columns assembly.energy_parts of the model's effects
     energy_tally: np.ndarray  # (TALLY.size,) what the last trial step's energy budget saw (layout.TALLY)
     collision: CollisionWorkspace
-    barrier: BarrierWorkspace
+    barrier: BarrierWorkspace | None  # None: the model has no self-contact barrier
 
 
 class State(NamedTuple):
@@ -245,9 +245,11 @@ def ground_array(grounds):
     return out
 
 
-def build_workspace(n_nodes, n_rings=1, effects=EFFECTS):
+def build_workspace(n_nodes, n_rings=1, effects=EFFECTS, barrier=True):
     """Scratch arrays for one ring's Newton solve and the scene's collision detection, allocated
-    once per simulation (``effects``: the model's, for the size of the energy table)."""
+    once per simulation (``effects``: the model's, for the size of the energy table; ``barrier``:
+    the self-contact barrier's scratch, or None in its place for a model without it, whose
+    compiled step then holds none of the barrier's code)."""
     n2 = 2 * n_nodes
     return Workspace(
         pos=zigzag_positions(n_nodes),
@@ -268,7 +270,7 @@ def build_workspace(n_nodes, n_rings=1, effects=EFFECTS):
         energy=np.zeros(len(energy_parts(effects))),
         energy_tally=np.zeros(TALLY.size),
         collision=build_collision_workspace(n_rings, n_nodes),
-        barrier=build_barrier_workspace(n_nodes),
+        barrier=build_barrier_workspace(n_nodes) if barrier else None,
     )
 
 

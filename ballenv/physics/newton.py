@@ -63,7 +63,7 @@ def residual(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active):
     kinematics(solver, x0, v0, a0, h, x1, v1, a1, ws)
     ring_force(model, r, ws.xe, ws.ve, ws.force)
     if model.self_barrier:
-        add_barrier_force(model, r, ws)
+        add_barrier_force(model, r, ws, ws.barrier)
     res = ws.res
     f = ws.force
     scale = 0.0
@@ -99,28 +99,26 @@ def correction(model, solver, r, x0, h, ws, active):
     m = model.node_mass[r]
     c_mass, c_x, c_v, _ = coefficients(solver, h)
     rank = ring_jacobian(model, r, ws.xe, ws.ve, c_mass, c_x, c_v, ws)
-    bw = ws.barrier
     wide = rank
-    if model.self_barrier and bw.mode[0] == SAFE and bw.n_pairs[0] > 0:
-        wide = barrier_jacobian(
-            ws.xe, bw.pairs, bw.n_pairs[0], stiffness(model, r), reach(model, r), c_x, ws.band, ws.pos,
-            bw.u, bw.w, rank, bw,
-        )  # fmt: skip
+    if model.self_barrier:
+        wide = add_barrier_jacobian(model, r, c_x, ws, rank, ws.barrier)
     if model.contact_method != CONTACT_NONE:
         constrain_jacobian(
             model.grounds, active, ws.ve, ws.reaction, ws.band, ws.pos, ws.u, rank, m, c_mass,
             c_v, model.friction_regularization,
         )  # fmt: skip
         if wide > rank:
-            constrain_low_rank_rows(
-                model.grounds, active, ws.ve, bw.u, rank, wide, model.friction_regularization
-            )
+            constrain_barrier_rows(model, active, ws, rank, wide, ws.barrier)
     res = ws.res
-    if not solve_jacobian(ws, rank, wide, res):
+    if wide == rank:
+        solved = solve_band_low_rank(ws.band, ws.pos, ws.u, ws.w, rank, res, ws.work, ws.cap, ws.coef)
+    else:
+        solved = solve_wide(ws, rank, wide, res, ws.barrier)
+    if not solved:
         return False, False
     cut = 1.0
-    if model.self_barrier and bw.mode[0] == SAFE:
-        cut = barrier_filter(model, r, c_x, ws, res)
+    if model.self_barrier:
+        cut = barrier_filter(model, r, c_x, ws, res, ws.barrier)
         if cut < 0.0:
             return False, False
     dx = ws.dx  # (arrays taken out of the workspace once, not per element)
@@ -139,13 +137,40 @@ def correction(model, solver, r, x0, h, ws, active):
     return True, step <= 1e-13 * size
 
 
-@kernel(inline="always")
-def solve_jacobian(ws, rank, wide, res):
-    """Solve the Newton system in place of ``res``: band plus the effects' ``rank`` low-rank
-    columns, or, with the barrier's columns up to ``wide``, all of them by the wide solver."""
-    if wide == rank:
-        return solve_band_low_rank(ws.band, ws.pos, ws.u, ws.w, rank, res, ws.work, ws.cap, ws.coef)
-    bw = ws.barrier
+# The barrier's phases below are compiled functions (not inlined) that take the barrier's
+# workspace ``bw`` as an argument: a scene without the barrier has ``Workspace.barrier = None``, and
+# numba then prunes their bodies (``if bw is None``) before typing them, so the env and every scene
+# without it compile and run none of the barrier's code.
+
+
+@kernel
+def add_barrier_jacobian(model, r, c_x, ws, rank, bw):
+    """In safe mode, the barrier's Jacobian at ``ws.xe``: its near blocks into the band, its far
+    couplings as low-rank columns ``rank ... wide - 1`` of ``bw.u, bw.w``. Returns ``wide``."""
+    if bw is None:
+        return rank
+    if bw.mode[0] != SAFE or bw.n_pairs[0] == 0:
+        return rank
+    return barrier_jacobian(
+        ws.xe, bw.pairs, bw.n_pairs[0], stiffness(model, r), reach(model, r), c_x, ws.band, ws.pos,
+        bw.u, bw.w, rank, bw,
+    )  # fmt: skip
+
+
+@kernel
+def constrain_barrier_rows(model, active, ws, rank, wide, bw):
+    """The ground constraints on the barrier's low-rank columns ``rank ... wide - 1``."""
+    if bw is None:
+        return
+    constrain_low_rank_rows(model.grounds, active, ws.ve, bw.u, rank, wide, model.friction_regularization)
+
+
+@kernel
+def solve_wide(ws, rank, wide, res, bw):
+    """Solve the Newton system in place of ``res`` with the barrier's columns up to ``wide`` besides
+    the effects' ``rank``: all of them by the wide solver. False without a barrier."""
+    if bw is None:
+        return False
     for k in range(res.shape[0]):
         for c in range(rank):
             bw.u[k, c] = ws.u[k, c]
@@ -154,12 +179,16 @@ def solve_jacobian(ws, rank, wide, res):
 
 
 @kernel
-def barrier_filter(model, r, c_x, ws, res):
+def barrier_filter(model, r, c_x, ws, res, bw):
     """The fraction (in (0, 1]) of the correction ``-res`` to take so that no node meets an edge of
     its own ring on the way (:mod:`.barrier`): the candidate pairs over the motion of the force
     evaluation point ``ws.xe -> ws.xe - c_x res`` replace the barrier's pairs, and the first impact
-    among them cuts the correction to ``CCD_SAFETY`` of it. Returns -1 if the pairs do not fit."""
-    bw = ws.barrier
+    among them cuts the correction to ``CCD_SAFETY`` of it. Returns -1 if the pairs do not fit; 1
+    outside safe mode."""
+    if bw is None:
+        return 1.0
+    if bw.mode[0] != SAFE:
+        return 1.0
     xe = ws.xe
     for i in range(xe.shape[0]):
         for d in range(2):
@@ -181,21 +210,23 @@ def _cut_at_impact(model, r, xa, bw):
     return CCD_SAFETY * first if first <= 1.0 else 1.0
 
 
-@kernel(inline="always")
-def add_barrier_force(model, r, ws):
+@kernel
+def add_barrier_force(model, r, ws, bw):
     """In safe mode, add the self-contact barrier's force at the force evaluation point ``ws.xe``
     (on the candidate pairs of the last correction's motion) to ``ws.force``."""
-    bw = ws.barrier
+    if bw is None:
+        return
     if bw.mode[0] == SAFE and bw.n_pairs[0] > 0:
         barrier_force(ws.xe, bw.pairs, bw.n_pairs[0], stiffness(model, r), reach(model, r), ws.force, bw)
 
 
 @kernel
-def barrier_start(model, solver, r, x0, h, ws):
+def barrier_start(model, solver, r, x0, h, ws, bw):
     """With the barrier: the candidate pairs over the predictor's motion (force evaluation point
     ``x0 -> x0 + c_x dx``) and the predictor cut before its first impact. False if they do not
     fit."""
-    bw = ws.barrier
+    if bw is None:
+        return True
     if not (model.self_barrier and bw.mode[0] == SAFE):
         return True
     _, c_x, _, _ = coefficients(solver, h)
@@ -251,7 +282,14 @@ def newton_ring(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active):
     """
     if not model.self_barrier:
         return newton_iterate(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active)
-    bw = ws.barrier
+    return newton_with_barrier(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active, ws.barrier)
+
+
+@kernel
+def newton_with_barrier(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active, bw):
+    """:func:`newton_ring` with the self-contact barrier's workspace ``bw`` (None: the plain step)."""
+    if bw is None:
+        return newton_iterate(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active)
     rest_len, dhat = model.rest_len[r], reach(model, r)
     its = 0
     if near_pairs(x0, rest_len, dhat, bw) == 0:
@@ -288,7 +326,7 @@ def newton_iterate(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active):
     inner_updates = model.contact_method == CONTACT_MASS_MODIFICATION
     set_changes = 0
     predict(solver, v0, a0, h, ws.dx)
-    if not barrier_start(model, solver, r, x0, h, ws):
+    if not barrier_start(model, solver, r, x0, h, ws, ws.barrier):
         return FAILED
     if contact and inner_updates:
         kinematics(solver, x0, v0, a0, h, x1, v1, a1, ws)
@@ -322,7 +360,7 @@ def newton_iterate(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active):
             merit_before = math.inf
             if not inner_updates:
                 predict(solver, v0, a0, h, ws.dx)
-                if not barrier_start(model, solver, r, x0, h, ws):
+                if not barrier_start(model, solver, r, x0, h, ws, ws.barrier):
                     return FAILED
             continue  # the residual's rows changed with the set
         if it >= solver.newton_max_iter:
