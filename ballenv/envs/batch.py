@@ -470,7 +470,8 @@ class BallBatch:
         self.n_nodes = scene.rings[0].n_nodes
         self.model = _tiled_model(build_model(scene), n_envs)
         self.solver = build_solver(scene)
-        self.ws = build_workspace(self.n_nodes)
+        barrier = bool(self.model.self_barrier)  # None in its place: the step compiles without it
+        self.ws = build_workspace(self.n_nodes, barrier=barrier)
         self.state = empty_state(n_envs, self.n_nodes)
         self.trial = empty_state(n_envs, self.n_nodes)
         self.clocks = np.zeros((n_envs, N_CLOCK))
@@ -511,7 +512,7 @@ class BallBatch:
         if self.threads > 1:
             self._pool = ThreadPoolExecutor(self.threads - 1, thread_name_prefix="ballenv")
             self._scratch = [(self.ws, self.nodes)] + [
-                (build_workspace(self.n_nodes), np.zeros(self.n_nodes, dtype=np.int64))
+                (build_workspace(self.n_nodes, barrier=barrier), np.zeros(self.n_nodes, dtype=np.int64))
                 for _ in range(self.threads - 1)
             ]
             chunks = min(n_envs, CHUNKS_PER_THREAD * self.threads)

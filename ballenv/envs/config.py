@@ -126,6 +126,7 @@ class BallEnvConfig:
             grounds=[Ground(angle=0.0, height=0.0, friction=self.friction)],
             gravity=self.gravity,
             damping=self.damping,
+            self_intersection="reject",  # the env's dynamics: no self-contact barrier
         )
         return with_fidelity(base, self.fidelity)
 

@@ -85,7 +85,7 @@ def recount_energy(model, r, x, v, energy, ws):
     """Recompute ring ``r``'s carried energy (columns ``layout.ENERGY``) after an actuation; the
     change of energy is added to the ring's energy budget."""
     before = energy[ENERGY_TOTAL]
-    free_energy(model, r, x, v, ws.energy, energy)
+    free_energy(model, r, x, v, ws, energy)
     energy[ENERGY_BUDGET] += energy[ENERGY_TOTAL] - before
 
 

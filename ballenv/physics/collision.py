@@ -57,7 +57,9 @@ would push neighbours apart), at the contact distance ``2 h``, toward the side i
 self-crossing state is never accepted: :func:`self_intersects` tests every trial state and the
 stepper rejects it (a star-shape test around the centroid proves most states simple in O(N); only
 the others pay the O(N^2) segment test). Wall parts far apart along the ring (a ball squashed
-flat until its top touches its bottom) get no impulse, only the rejection.
+flat until its top touches its bottom) get no impulse: the self-contact barrier inside the implicit
+step keeps them apart (:mod:`.barrier`, ``Scene.self_intersection = "barrier"``), or, with
+``"reject"``, only the rejection.
 """
 
 import math

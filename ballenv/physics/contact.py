@@ -124,6 +124,29 @@ def constrain_jacobian(grounds, active, ve, reaction, band, pos, u, rank, node_m
 
 
 @kernel
+def constrain_low_rank_rows(grounds, active, ve, u, first, last, eps):
+    """Apply the row combinations of :func:`constrain_residual` to columns ``first .. last - 1``
+    of a low-rank factor ``u`` (natural order), as :func:`constrain_jacobian` does to its own."""
+    for i in range(active.shape[0]):
+        g = active[i]
+        if g == FREE:
+            continue
+        nx, ny, mu = grounds[g, 0], grounds[g, 1], grounds[g, 3]
+        tx, ty = -ny, nx
+        s = 0.0
+        if mu > 0.0:
+            vt = tx * ve[i, 0] + ty * ve[i, 1]
+            s = vt / math.sqrt(vt * vt + eps * eps)
+        ax = tx + mu * s * nx
+        ay = ty + mu * s * ny
+        swap = abs(nx) > abs(ny)
+        for k in range(first, last):
+            ut = ax * u[2 * i, k] + ay * u[2 * i + 1, k]
+            u[2 * i, k] = 0.0 if swap else ut
+            u[2 * i + 1, k] = ut if swap else 0.0
+
+
+@kernel
 def activate_penetrating(grounds, active, x1, only_deeper_than):
     """Constrain free nodes below a ground; returns True if any was added."""
     changed = False

@@ -12,6 +12,7 @@ actuation and collision impulses gave it since). The energy parts come from the 
 import math
 
 from .assembly import gravity_column, ring_energy
+from .barrier import barrier_energy, find_pairs, reach, stiffness
 from .contact import rest_on_grounds
 from .geometry import centre_of_mass
 from .jit import kernel
@@ -21,13 +22,31 @@ ENERGY_GROWTH_TOL = 1e-2  # largest energy gain of a step, relative to the ring'
 
 
 @kernel
-def free_energy(model, r, x, v, parts, out):
+def free_energy(model, r, x, v, ws, out):
     """``out[ENERGY_TOTAL]`` = the energy (J) of ring ``r``; ``out[ENERGY_FREE]`` = its free part:
-    kinetic plus elastic and gas energy above the inflated circle at rest (``Model.rest_energy``),
-    gravity left out. Other columns of ``out`` are left alone."""
+    kinetic plus elastic, gas and self-contact barrier energy (:func:`barrier.barrier_energy`)
+    above the inflated circle at rest (``Model.rest_energy``), gravity left out. The effects' parts
+    are left in ``ws.energy``; other columns of ``out`` are left alone."""
+    parts = ws.energy
     out[ENERGY_TOTAL] = ring_energy(model, r, x, v, parts)
+    if model.self_barrier:
+        out[ENERGY_TOTAL] += self_contact_energy(model, r, x, ws.barrier)
     g = gravity_column(model)
     out[ENERGY_FREE] = out[ENERGY_TOTAL] - (parts[g] if g >= 0 else 0.0) - model.rest_energy[r]
+
+
+@kernel
+def self_contact_energy(model, r, x, bw):
+    """The self-contact barrier's energy (J) of ring ``r`` at nodes ``x``: 0 without a pair within
+    ``dhat`` (then exactly nothing is added), or without the barrier's workspace (``bw`` None)."""
+    if bw is None:
+        return 0.0
+    count = find_pairs(x, x, model.rest_len[r], reach(model, r), bw)
+    if count == 0:
+        return 0.0
+    if count < 0:
+        return math.inf
+    return barrier_energy(x, bw.pairs, count, stiffness(model, r), reach(model, r))
 
 
 @kernel
@@ -90,7 +109,7 @@ def within_energy_budget(model, r, before, kick, trial, ws):
     if not remove_internal_kinetic_energy(trial.x[r], trial.v[r], model.node_mass[r], excess):
         return excess <= 1e-12 * _energy_scale(model, r, trial.x[r], ws.energy)
     rest_on_grounds(model.grounds, trial.active[r], trial.v[r], trial.a[r])
-    free_energy(model, r, trial.x[r], trial.v[r], ws.energy, after)
+    free_energy(model, r, trial.x[r], trial.v[r], ws, after)
     ws.energy_tally[TALLY_PROJECTED] += 1.0
     ws.energy_tally[TALLY_REMOVED] += excess
     return True

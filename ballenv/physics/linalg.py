@@ -202,3 +202,60 @@ def band_to_dense(band, pos):
     dof[0::2] = 2 * pos
     dof[1::2] = 2 * pos + 1
     return dense_band_order[np.ix_(dof, dof)]
+
+
+@kernel
+def _solve_columns(lu, pos, src, first, count, work, dst):
+    """``dst[:, first:first + count] = B^-1 src[:, first:first + count]`` (natural order), in chunks
+    of ``SOLVE_COLUMNS`` through the factor ``lu`` of :func:`band_lu`; ``work`` is scratch."""
+    n_nodes = pos.shape[0]
+    for start in range(first, first + count, SOLVE_COLUMNS):
+        stop = min(start + SOLVE_COLUMNS, first + count)
+        for node in range(n_nodes):
+            p = 2 * pos[node]
+            for d in range(2):
+                for c in range(SOLVE_COLUMNS):
+                    work[p + d, c] = src[2 * node + d, start + c] if start + c < stop else 0.0
+        band_lu_solve(lu, work)
+        for node in range(n_nodes):
+            p = 2 * pos[node]
+            for d in range(2):
+                for c in range(stop - start):
+                    dst[2 * node + d, start + c] = work[p + d, c]
+
+
+@kernel
+def solve_band_wide_low_rank(band, pos, u, v, rank, rhs, work, z, cap, coef):
+    """Solve (B + U V^T) x = rhs in place for ``rank`` low-rank columns of any number (``u``, ``v``
+    (2N, >= rank) natural order): the Woodbury identity with ``Z = B^-1 U`` solved in chunks,
+    ``O(N (w + rank) rank + rank^3)``. ``band`` is overwritten by its LU factor, ``rhs`` (2N,) by
+    the solution. Scratch: ``work`` (2N, SOLVE_COLUMNS), ``z`` (2N, >= rank + 1), ``cap``
+    (>= rank, >= rank), ``coef`` (>= rank,). Returns False if the factorisation breaks down."""
+    if not band_lu(band):
+        return False
+    n = rhs.shape[0]
+    for k in range(n):
+        z[k, rank] = rhs[k]  # the right-hand side rides along as the last column
+        for c in range(rank):
+            z[k, c] = u[k, c]
+    _solve_columns(band, pos, z, 0, rank + 1, work, z)
+    for a in range(rank):
+        s = 0.0
+        for c in range(rank):
+            cap[a, c] = 1.0 if a == c else 0.0
+        for k in range(n):
+            va = v[k, a]
+            if va == 0.0:
+                continue
+            s += va * z[k, rank]
+            for c in range(rank):
+                cap[a, c] += va * z[k, c]
+        coef[a] = s
+    if rank > 0 and not _small_solve(cap, coef, rank):
+        return False
+    for k in range(n):
+        s = z[k, rank]
+        for c in range(rank):
+            s -= z[k, c] * coef[c]
+        rhs[k] = s
+    return True

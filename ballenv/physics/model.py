@@ -21,6 +21,7 @@ from .assembly import (
     parameter_table,
     ring_energy,
 )
+from .barrier import PAIRS_PER_NODE
 from .collision import CONTACT_COLUMNS, CONTACTS_PER_NODE
 from .effects import EFFECTS
 from .effects.damping import DAMPING_CENTRE_OF_MASS, DAMPING_NONE, DAMPING_RIGID
@@ -56,6 +57,7 @@ class Model(NamedTuple):
     thickness: np.ndarray  # (R,) m: wall thickness (the contact distance of two rings is h_a + h_b)
     collide: bool  # ring-ring collision (two or more rings and Scene.ring_collision)
     reject_self_intersection: bool  # reject trial states in which a ring crosses itself
+    self_barrier: bool  # the self-contact barrier of far wall parts (barrier.py)
     effect_parameters: np.ndarray  # (R,) records: one field per effect summed, its own parameters
 
 
@@ -82,6 +84,29 @@ class CollisionWorkspace(NamedTuple):
     velocity: np.ndarray  # (R, 3): centre-of-mass velocity (m/s), largest node speed relative to it
 
 
+class BarrierWorkspace(NamedTuple):
+    """Scratch of a ring's self-contact barrier (``barrier.py``) for rings of N nodes."""
+
+    pairs: np.ndarray  # (PAIRS_PER_NODE N, 2) int64: candidate (node, edge) pairs
+    n_pairs: np.ndarray  # (1,) int64: how many of them the Newton iteration uses
+    mode: np.ndarray  # (1,) int64: newton.PLAIN (no barrier) or newton.SAFE
+    active0: np.ndarray  # (N,) int64: the contact set at the step's start
+    order: np.ndarray  # (N,) int64: edges by the left edge of their box
+    left: np.ndarray  # (N,) m: left edge of each edge's box
+    box: np.ndarray  # (N, 4) m: each node's box over a motion
+    xn: np.ndarray  # (N, 2) m: the positions a Newton correction moves to
+    slot: np.ndarray  # (N,) int64: first low-rank column of a node's off-band row, or -1
+    nodes: np.ndarray  # (3,) int64: a pair's node and edge ends
+    g: np.ndarray  # (6,): gradient of a pair's squared distance
+    hess: np.ndarray  # (6, 6): its Hessian
+    scratch: np.ndarray  # (6, 6)
+    u: np.ndarray  # (2N, K) K = MAX_LOW_RANK + 2N: the effects' and the barrier's low-rank columns
+    w: np.ndarray  # (2N, K)
+    z: np.ndarray  # (2N, K + 1): B^-1 [u, rhs]
+    cap: np.ndarray  # (K, K)
+    coef: np.ndarray  # (K,)
+
+
 class Workspace(NamedTuple):
     pos: np.ndarray  # (N,) zig-zag position of each node
     band: np.ndarray  # (2N, BAND_COLUMNS)
@@ -101,6 +126,7 @@ class Workspace(NamedTuple):
     energy: np.ndarray  # (P,) energy parts (J), columns assembly.energy_parts of the model's effects
     energy_tally: np.ndarray  # (TALLY.size,) what the last trial step's energy budget saw (layout.TALLY)
     collision: CollisionWorkspace
+    barrier: BarrierWorkspace | None  # None: the model has no self-contact barrier
 
 
 class State(NamedTuple):
@@ -169,7 +195,8 @@ def build_model(scene, effects=EFFECTS):
         rest_energy=np.zeros(len(rings)),
         thickness=np.array([r.thickness for r in rings]),
         collide=len(rings) > 1 and scene.ring_collision,
-        reject_self_intersection=scene.self_intersection == "reject",
+        reject_self_intersection=scene.self_intersection in ("reject", "barrier"),
+        self_barrier=scene.self_intersection == "barrier",
         effect_parameters=effect_parameters(scene, effects),
     )
     _fill_rest_energy(model, rings)
@@ -218,9 +245,11 @@ def ground_array(grounds):
     return out
 
 
-def build_workspace(n_nodes, n_rings=1, effects=EFFECTS):
+def build_workspace(n_nodes, n_rings=1, effects=EFFECTS, barrier=True):
     """Scratch arrays for one ring's Newton solve and the scene's collision detection, allocated
-    once per simulation (``effects``: the model's, for the size of the energy table)."""
+    once per simulation (``effects``: the model's, for the size of the energy table; ``barrier``:
+    the self-contact barrier's scratch, or None in its place for a model without it, whose
+    compiled step then holds none of the barrier's code)."""
     n2 = 2 * n_nodes
     return Workspace(
         pos=zigzag_positions(n_nodes),
@@ -241,6 +270,33 @@ def build_workspace(n_nodes, n_rings=1, effects=EFFECTS):
         energy=np.zeros(len(energy_parts(effects))),
         energy_tally=np.zeros(TALLY.size),
         collision=build_collision_workspace(n_rings, n_nodes),
+        barrier=build_barrier_workspace(n_nodes) if barrier else None,
+    )
+
+
+def build_barrier_workspace(n_nodes):
+    """Scratch of the self-contact barrier for rings of ``n_nodes`` nodes."""
+    n2 = 2 * n_nodes
+    k = MAX_LOW_RANK + n2
+    return BarrierWorkspace(
+        pairs=np.zeros((PAIRS_PER_NODE * n_nodes, 2), dtype=np.int64),
+        n_pairs=np.zeros(1, dtype=np.int64),
+        mode=np.zeros(1, dtype=np.int64),
+        active0=np.zeros(n_nodes, dtype=np.int64),
+        order=np.arange(n_nodes, dtype=np.int64),
+        left=np.zeros(n_nodes),
+        box=np.zeros((n_nodes, 4)),
+        xn=np.zeros((n_nodes, 2)),
+        slot=np.full(n_nodes, -1, dtype=np.int64),
+        nodes=np.zeros(3, dtype=np.int64),
+        g=np.zeros(6),
+        hess=np.zeros((6, 6)),
+        scratch=np.zeros((6, 6)),
+        u=np.zeros((n2, k)),
+        w=np.zeros((n2, k)),
+        z=np.zeros((n2, k + 1)),
+        cap=np.zeros((k, k)),
+        coef=np.zeros(k),
     )
 
 

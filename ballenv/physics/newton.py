@@ -21,20 +21,34 @@ alone does not recover.
 import math
 
 from .assembly import ring_force, ring_jacobian
+from .barrier import (
+    CCD_SAFETY,
+    barrier_force,
+    barrier_jacobian,
+    find_pairs,
+    impact_fraction,
+    near_pairs,
+    reach,
+    stiffness,
+)
+from .collision import self_intersects
 from .contact import (
     FREE,
     PENETRATION_TOLERANCE,
     activate_penetrating,
     constrain_jacobian,
+    constrain_low_rank_rows,
     constrain_residual,
     rest_on_grounds,
 )
 from .integrator import coefficients, kinematics, predict
-from .jit import kernel
-from .linalg import solve_band_low_rank
+from .jit import copy_into, kernel
+from .linalg import solve_band_low_rank, solve_band_wide_low_rank
 from .model import CONTACT_MASS_MODIFICATION, CONTACT_NONE
 
 MAX_CONTACT_SET_CHANGES = 64
+PLAIN = 0  # Workspace.barrier.mode[0]: the step without the self-contact barrier
+SAFE = 1  # with it, every correction filtered by continuous collision detection
 MIN_NEWTON_FRACTION = 1.0 / 32.0  # backtracking halves a correction at most 5 times
 FAILED = -1
 
@@ -48,6 +62,8 @@ def residual(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active):
     c_mass, _, _, am = coefficients(solver, h)
     kinematics(solver, x0, v0, a0, h, x1, v1, a1, ws)
     ring_force(model, r, ws.xe, ws.ve, ws.force)
+    if model.self_barrier:
+        add_barrier_force(model, r, ws, ws.barrier)
     res = ws.res
     f = ws.force
     scale = 0.0
@@ -83,21 +99,35 @@ def correction(model, solver, r, x0, h, ws, active):
     m = model.node_mass[r]
     c_mass, c_x, c_v, _ = coefficients(solver, h)
     rank = ring_jacobian(model, r, ws.xe, ws.ve, c_mass, c_x, c_v, ws)
+    wide = rank
+    if model.self_barrier:
+        wide = add_barrier_jacobian(model, r, c_x, ws, rank, ws.barrier)
     if model.contact_method != CONTACT_NONE:
         constrain_jacobian(
             model.grounds, active, ws.ve, ws.reaction, ws.band, ws.pos, ws.u, rank, m, c_mass,
             c_v, model.friction_regularization,
         )  # fmt: skip
+        if wide > rank:
+            constrain_barrier_rows(model, active, ws, rank, wide, ws.barrier)
     res = ws.res
-    if not solve_band_low_rank(ws.band, ws.pos, ws.u, ws.w, rank, res, ws.work, ws.cap, ws.coef):
+    if wide == rank:
+        solved = solve_band_low_rank(ws.band, ws.pos, ws.u, ws.w, rank, res, ws.work, ws.cap, ws.coef)
+    else:
+        solved = solve_wide(ws, rank, wide, res, ws.barrier)
+    if not solved:
         return False, False
+    cut = 1.0
+    if model.self_barrier:
+        cut = barrier_filter(model, r, c_x, ws, res, ws.barrier)
+        if cut < 0.0:
+            return False, False
     dx = ws.dx  # (arrays taken out of the workspace once, not per element)
     delta = ws.delta
     step = 0.0
     size = 0.0
     for i in range(n):
         for d in range(2):
-            c = res[2 * i + d]
+            c = res[2 * i + d] * cut
             if not math.isfinite(c):
                 return False, False
             delta[i, d] = c
@@ -105,6 +135,111 @@ def correction(model, solver, r, x0, h, ws, active):
             step = max(step, abs(c))
             size = max(size, abs(x0[i, d]) + abs(dx[i, d]))
     return True, step <= 1e-13 * size
+
+
+# The barrier's phases below are compiled functions (not inlined) that take the barrier's
+# workspace ``bw`` as an argument: a scene without the barrier has ``Workspace.barrier = None``, and
+# numba then prunes their bodies (``if bw is None``) before typing them, so the env and every scene
+# without it compile and run none of the barrier's code.
+
+
+@kernel
+def add_barrier_jacobian(model, r, c_x, ws, rank, bw):
+    """In safe mode, the barrier's Jacobian at ``ws.xe``: its near blocks into the band, its far
+    couplings as low-rank columns ``rank ... wide - 1`` of ``bw.u, bw.w``. Returns ``wide``."""
+    if bw is None:
+        return rank
+    if bw.mode[0] != SAFE or bw.n_pairs[0] == 0:
+        return rank
+    return barrier_jacobian(
+        ws.xe, bw.pairs, bw.n_pairs[0], stiffness(model, r), reach(model, r), c_x, ws.band, ws.pos,
+        bw.u, bw.w, rank, bw,
+    )  # fmt: skip
+
+
+@kernel
+def constrain_barrier_rows(model, active, ws, rank, wide, bw):
+    """The ground constraints on the barrier's low-rank columns ``rank ... wide - 1``."""
+    if bw is None:
+        return
+    constrain_low_rank_rows(model.grounds, active, ws.ve, bw.u, rank, wide, model.friction_regularization)
+
+
+@kernel
+def solve_wide(ws, rank, wide, res, bw):
+    """Solve the Newton system in place of ``res`` with the barrier's columns up to ``wide`` besides
+    the effects' ``rank``: all of them by the wide solver. False without a barrier."""
+    if bw is None:
+        return False
+    for k in range(res.shape[0]):
+        for c in range(rank):
+            bw.u[k, c] = ws.u[k, c]
+            bw.w[k, c] = ws.w[k, c]
+    return solve_band_wide_low_rank(ws.band, ws.pos, bw.u, bw.w, wide, res, ws.work, bw.z, bw.cap, bw.coef)
+
+
+@kernel
+def barrier_filter(model, r, c_x, ws, res, bw):
+    """The fraction (in (0, 1]) of the correction ``-res`` to take so that no node meets an edge of
+    its own ring on the way (:mod:`.barrier`): the candidate pairs over the motion of the force
+    evaluation point ``ws.xe -> ws.xe - c_x res`` replace the barrier's pairs, and the first impact
+    among them cuts the correction to ``CCD_SAFETY`` of it. Returns -1 if the pairs do not fit; 1
+    outside safe mode."""
+    if bw is None:
+        return 1.0
+    if bw.mode[0] != SAFE:
+        return 1.0
+    xe = ws.xe
+    for i in range(xe.shape[0]):
+        for d in range(2):
+            bw.xn[i, d] = xe[i, d] - c_x * res[2 * i + d]
+    return _cut_at_impact(model, r, xe, bw)
+
+
+@kernel(inline="always")
+def _cut_at_impact(model, r, xa, bw):
+    """Candidate pairs over the motion ``xa -> bw.xn`` into ``bw.pairs``, ``bw.n_pairs``; the fraction
+    of the motion before the first impact (``CCD_SAFETY`` of it, or 1), -1 if they do not fit."""
+    count = find_pairs(xa, bw.xn, model.rest_len[r], reach(model, r), bw)
+    bw.n_pairs[0] = max(count, 0)
+    if count < 0:
+        return -1.0
+    if count == 0:
+        return 1.0
+    first = impact_fraction(xa, bw.xn, bw.pairs, count)
+    return CCD_SAFETY * first if first <= 1.0 else 1.0
+
+
+@kernel
+def add_barrier_force(model, r, ws, bw):
+    """In safe mode, add the self-contact barrier's force at the force evaluation point ``ws.xe``
+    (on the candidate pairs of the last correction's motion) to ``ws.force``."""
+    if bw is None:
+        return
+    if bw.mode[0] == SAFE and bw.n_pairs[0] > 0:
+        barrier_force(ws.xe, bw.pairs, bw.n_pairs[0], stiffness(model, r), reach(model, r), ws.force, bw)
+
+
+@kernel
+def barrier_start(model, solver, r, x0, h, ws, bw):
+    """With the barrier: the candidate pairs over the predictor's motion (force evaluation point
+    ``x0 -> x0 + c_x dx``) and the predictor cut before its first impact. False if they do not
+    fit."""
+    if bw is None:
+        return True
+    if not (model.self_barrier and bw.mode[0] == SAFE):
+        return True
+    _, c_x, _, _ = coefficients(solver, h)
+    dx = ws.dx
+    for i in range(x0.shape[0]):
+        for d in range(2):
+            bw.xn[i, d] = x0[i, d] + c_x * dx[i, d]
+    cut = _cut_at_impact(model, r, x0, bw)
+    if cut < 1.0:
+        for i in range(x0.shape[0]):
+            for d in range(2):
+                dx[i, d] *= max(cut, 0.0)
+    return cut >= 0.0
 
 
 @kernel(inline="always")
@@ -133,6 +268,44 @@ def backtrack(ws, lam):
 
 @kernel
 def newton_ring(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active):
+    """Solve one implicit step of ring ``r`` (:func:`newton_iterate`); ``x1, v1, a1`` receive the
+    new state, ``active`` the step's contact set. Returns the number of Newton corrections (>= 0),
+    or ``FAILED``.
+
+    With the self-contact barrier (``model.self_barrier``): a step that starts with no
+    pair of the ring within ``dhat`` is first solved without it; if it ends with none either (or
+    fails, or ends crossing itself: the stepper then rejects it and retries it smaller, until the
+    wall parts meet within a step), that is the step, bit for bit the step without the barrier.
+    Otherwise the step is solved in safe mode: the barrier acts, and the predictor and every
+    correction are cut before their first impact (:func:`barrier_filter`), so no iterate passes a
+    wall through another.
+    """
+    if not model.self_barrier:
+        return newton_iterate(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active)
+    return newton_with_barrier(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active, ws.barrier)
+
+
+@kernel
+def newton_with_barrier(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active, bw):
+    """:func:`newton_ring` with the self-contact barrier's workspace ``bw`` (None: the plain step)."""
+    if bw is None:
+        return newton_iterate(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active)
+    rest_len, dhat = model.rest_len[r], reach(model, r)
+    its = 0
+    if near_pairs(x0, rest_len, dhat, bw) == 0:
+        bw.mode[0] = PLAIN
+        copy_into(bw.active0, active)
+        its = newton_iterate(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active)
+        if its < 0 or self_intersects(x1) or near_pairs(x1, rest_len, dhat, bw) == 0:
+            return its
+        copy_into(active, bw.active0)
+    bw.mode[0] = SAFE
+    safe = newton_iterate(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active)
+    return FAILED if safe < 0 else safe + its
+
+
+@kernel
+def newton_iterate(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active):
     """Solve one implicit step of ring ``r``; ``x1, v1, a1`` receive the new state.
 
     ``active`` (N,) holds each node's constraining ground (or FREE) and is updated to the step's
@@ -153,6 +326,8 @@ def newton_ring(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active):
     inner_updates = model.contact_method == CONTACT_MASS_MODIFICATION
     set_changes = 0
     predict(solver, v0, a0, h, ws.dx)
+    if not barrier_start(model, solver, r, x0, h, ws, ws.barrier):
+        return FAILED
     if contact and inner_updates:
         kinematics(solver, x0, v0, a0, h, x1, v1, a1, ws)
         if activate_penetrating(model.grounds, active, x1, PENETRATION_TOLERANCE):
@@ -185,6 +360,8 @@ def newton_ring(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active):
             merit_before = math.inf
             if not inner_updates:
                 predict(solver, v0, a0, h, ws.dx)
+                if not barrier_start(model, solver, r, x0, h, ws, ws.barrier):
+                    return FAILED
             continue  # the residual's rows changed with the set
         if it >= solver.newton_max_iter:
             return FAILED

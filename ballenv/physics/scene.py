@@ -18,7 +18,7 @@ from .ring import burst_pressure, crush_pressure
 INTEGRATORS = ("backward_euler", "generalized_alpha")
 DAMPING_MODES = ("rigid", "centre_of_mass")
 CONTACT_METHODS = ("mass_modification", "predictor_corrector")
-SELF_INTERSECTION = ("reject", "ignore")
+SELF_INTERSECTION = ("barrier", "reject", "ignore")
 
 T = TypeVar("T")
 
@@ -259,7 +259,10 @@ class Scene:
         ring_collision: rings push each other apart when a node comes within the contact distance
             ``h_a + h_b`` of another ring's centreline (``collision.py``); only with two or more
             rings. False lets rings pass through each other.
-        self_intersection: "reject" (wall parts of a ring within a few edges of each other along
+        self_intersection: "barrier" (default: "reject", and wall parts of a ring far apart
+            along it repel through a barrier potential inside the implicit step, with continuous
+            collision detection on the Newton iterates, so a squashed ring rests folded;
+            ``barrier.py``), "reject" (wall parts of a ring within a few edges of each other along
             the ring push apart like two rings, and a trial state in which a ring's polygon crosses
             itself is rejected and the step retried smaller; at ``dt_min`` simulate() stops with
             SimulationError) or "ignore" (neither).
@@ -285,7 +288,7 @@ class Scene:
     atmospheric_pressure: float = 101325.0
     gas_exponent: float = 1.0
     ring_collision: bool = True
-    self_intersection: str = "reject"
+    self_intersection: str = "barrier"
 
     def __post_init__(self) -> None:
         o = "Scene"

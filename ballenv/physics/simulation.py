@@ -235,7 +235,7 @@ class Simulation:
         self.model = build_model(scene, effects)
         self.solver = build_solver(scene)
         n_rings, n_nodes = len(scene.rings), scene.rings[0].n_nodes
-        self.ws = build_workspace(n_nodes, n_rings, effects)
+        self.ws = build_workspace(n_nodes, n_rings, effects, barrier=self.model.self_barrier)
         self.state = empty_state(n_rings, n_nodes)
         self.trial = empty_state(n_rings, n_nodes)
         shape = (n_rings, n_nodes, 2)
@@ -453,10 +453,10 @@ def _check_ring_shapes(caller: str, scene: Scene, x: NDArray[np.float64]) -> Non
                 f"{caller}.x0: the nodes of ring {r} run clockwise (signed area {area:.3g} m^2): they must "
                 "be in counter-clockwise order, as on the ring's circle (reverse their order)"
             )
-        if scene.self_intersection == "reject" and self_intersects(nodes):
+        if scene.self_intersection != "ignore" and self_intersects(nodes):
             raise ValueError(
                 f"{caller}.x0: the wall of ring {r} crosses itself: it must be a simple "
-                "polygon (Scene.self_intersection = 'reject' refuses every self-crossing state)"
+                "polygon (Scene.self_intersection = 'barrier' or 'reject' refuses every self-crossing state)"
             )
 
 

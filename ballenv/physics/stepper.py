@@ -60,7 +60,7 @@ def initial_state_values(model, solver, state, ws):
     """Fill what the stepper carries besides ``x, v``: every ring's energy (its budget = its energy
     now) and, for an integrator that carries it, its start acceleration."""
     for r in range(state.x.shape[0]):
-        free_energy(model, r, state.x[r], state.v[r], ws.energy, state.energy[r])
+        free_energy(model, r, state.x[r], state.v[r], ws, state.energy[r])
         state.energy[r, ENERGY_BUDGET] = state.energy[r, ENERGY_TOTAL]
     if carries_acceleration(solver):
         initial_acceleration(model, state.x, state.v, state.a, ws)
@@ -109,7 +109,7 @@ def step_ring(model, solver, r, state, v0, trial, h, ws):
         return -REJECT_NEWTON
     if model.reject_self_intersection and self_intersects(trial.x[r]):
         return -REJECT_SELF_INTERSECTION
-    free_energy(model, r, trial.x[r], trial.v[r], ws.energy, trial.energy[r])
+    free_energy(model, r, trial.x[r], trial.v[r], ws, trial.energy[r])
     kicks = model.collide or model.reject_self_intersection
     kick = ws.collision.kinetic_change[r] if kicks else 0.0
     trial.energy[r, ENERGY_BUDGET] = state.energy[r, ENERGY_BUDGET] + kick

@@ -5,7 +5,7 @@ import pytest
 
 from ballenv.physics import Ground, Ring, Scene, simulate
 from ballenv.physics.energy import energy_grew, free_energy
-from ballenv.physics.model import build_model
+from ballenv.physics.model import build_model, build_workspace
 from ballenv.physics.simulation import initial_state
 
 
@@ -49,12 +49,12 @@ def test_energy_guard_flags_a_step_that_adds_energy():
     scene = Scene(rings=[Ring(position=(0.0, 0.0))], gravity=0.0)
     model = build_model(scene)
     x, v = initial_state(scene)
-    parts = np.zeros(5)
+    ws = build_workspace(x.shape[1])
     moving = v[0] + np.array([0.0, 0.05])  # kinetic energy from nowhere
     at_rest, kicked, broken = np.zeros(2), np.zeros(2), np.zeros(2)
-    free_energy(model, 0, x[0], v[0], parts, at_rest)
-    free_energy(model, 0, x[0], moving, parts, kicked)
-    free_energy(model, 0, x[0], np.full_like(moving, np.nan), parts, broken)
+    free_energy(model, 0, x[0], v[0], ws, at_rest)
+    free_energy(model, 0, x[0], moving, ws, kicked)
+    free_energy(model, 0, x[0], np.full_like(moving, np.nan), ws, broken)
     assert at_rest[1] == pytest.approx(0.0, abs=1e-12 * at_rest[0])  # the inflated circle is the rest state
     assert not energy_grew(*at_rest, *at_rest)
     assert energy_grew(*at_rest, *kicked)

@@ -54,12 +54,14 @@ def test_the_cases_are_as_hard_as_named():
 
 
 @pytest.mark.parametrize("integrator", INTEGRATORS)
-def test_a_deflated_ring_squashed_flat_stops_with_a_documented_error(integrator):
-    """Known limit (collision.py): wall parts far apart along a ring get no contact impulse, only the
-    rejection of a self-crossing state. A ring without gas squashed flat sags until its top wall
-    meets its bottom wall; the run must then stop at dt_min saying so, with finite states."""
+def test_a_deflated_ring_squashed_flat_stops_with_a_documented_error_without_the_barrier(integrator):
+    """Known limit of ``Scene.self_intersection = "reject"`` (collision.py): wall parts far apart
+    along a ring get no contact impulse, only the rejection of a self-crossing state. A ring without
+    gas squashed flat sags until its top wall meets its bottom wall; the run must then stop at
+    dt_min saying so, with finite states."""
     case = released_flat("deflated", pressure=None)
-    scene = replace(case.scene, rings=[replace(case.scene.rings[0], pressure=None)], integrator=integrator)
+    ring = replace(case.scene.rings[0], pressure=None)
+    scene = replace(case.scene, rings=[ring], integrator=integrator, self_intersection="reject")
     with pytest.raises(SimulationError, match=r"Scene\.dt_min .*a ring's wall crossed itself") as err:
         simulate(scene, case.t_end, x0=case.x0, v0=case.v0)
     result = audit(scene, case.t_end, case.x0, case.v0)
@@ -67,6 +69,16 @@ def test_a_deflated_ring_squashed_flat_stops_with_a_documented_error(integrator)
     assert err.value.trajectory.t[-1] < case.t_end
     # the halving is bounded: from the last accepted step to dt_min takes about log2(h / dt_min) tries
     assert result.rejections["self_intersection"] <= 2 * math.log2(scene.dt / scene.dt_min)
+
+
+@pytest.mark.parametrize("integrator", INTEGRATORS)
+def test_a_deflated_ring_squashed_flat_completes_with_the_barrier(integrator):
+    """With the self-contact barrier (the default) the same ring's top wall rests on its bottom
+    wall: the run reaches its end and passes the audit."""
+    case = released_flat("deflated", pressure=None)
+    scene = replace(case.scene, rings=[replace(case.scene.rings[0], pressure=None)], integrator=integrator)
+    result = audit(scene, case.t_end, case.x0, case.v0)
+    assert result.reached_end and result.problems() == []
 
 
 def _violent_ring(**scene_kw):

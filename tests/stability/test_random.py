@@ -194,7 +194,7 @@ SCENE_FIELDS = {
     "atmospheric_pressure": out_of(0.0, 1e7),
     "gas_exponent": out_of(0.0, 3.0),
     "ring_collision": NOT_A_BOOL,
-    "self_intersection": bad_choice(("reject", "ignore")),
+    "self_intersection": bad_choice(("barrier", "reject", "ignore")),
 }
 ENV_FIELDS = {
     "action_mode": bad_choice(("pressure", "paddle")),

@@ -1,0 +1,230 @@
+"""The self-contact barrier: its distance derivatives and Jacobian against finite differences,
+continuous collision detection, the broad phase, and rings whose far wall parts meet."""
+
+import numpy as np
+import pytest
+
+from ballenv.physics import Ground, Ring, Scene, simulate
+from ballenv.physics.barrier import (
+    barrier_energy,
+    barrier_force,
+    barrier_jacobian,
+    beta,
+    beta_curvature,
+    beta_slope,
+    excluded,
+    find_pairs,
+    impact_fraction,
+    point_edge_derivatives,
+    point_edge_distance2,
+    point_edge_impact,
+)
+from ballenv.physics.collision import self_intersects
+from ballenv.physics.linalg import band_to_dense
+from ballenv.physics.model import build_model, build_workspace
+from ballenv.physics.simulation import initial_state
+
+# p, a, b with the foot of p on the segment, beyond a, and beyond b
+CONFIGURATIONS = {
+    "line": (0.3, 0.2, -0.1, 0.05, 1.0, -0.1),
+    "beyond a": (-0.4, 0.3, 0.0, 0.0, 1.0, 0.1),
+    "beyond b": (1.5, -0.2, 0.0, 0.0, 1.0, 0.1),
+}
+
+
+def _derivatives(z):
+    g, hess, scratch = np.zeros(6), np.zeros((6, 6)), np.zeros((6, 6))
+    s = point_edge_derivatives(*z, g, hess, scratch)
+    return s, g, hess
+
+
+@pytest.mark.parametrize("where", list(CONFIGURATIONS))
+def test_squared_distance_gradient_and_hessian_match_finite_differences(where):
+    z = np.array(CONFIGURATIONS[where])
+    s, g, hess = _derivatives(z)
+    assert s == pytest.approx(point_edge_distance2(*z), rel=1e-14)
+    eps = 1e-6
+    g_fd = np.zeros(6)
+    h_fd = np.zeros((6, 6))
+    for k in range(6):
+        dz = np.zeros(6)
+        dz[k] = eps
+        g_fd[k] = (point_edge_distance2(*(z + dz)) - point_edge_distance2(*(z - dz))) / (2 * eps)
+        h_fd[:, k] = (_derivatives(z + dz)[1] - _derivatives(z - dz)[1]) / (2 * eps)
+    np.testing.assert_allclose(g, g_fd, rtol=1e-8, atol=1e-9)
+    np.testing.assert_allclose(hess, h_fd, rtol=1e-6, atol=1e-7)
+
+
+def test_barrier_function_derivatives_and_support():
+    y = np.linspace(0.05, 0.95, 19)
+    eps = 1e-6
+    slope_fd = np.array([(beta(t + eps) - beta(t - eps)) / (2 * eps) for t in y])
+    curv_fd = np.array([(beta_slope(t + eps) - beta_slope(t - eps)) / (2 * eps) for t in y])
+    np.testing.assert_allclose([beta_slope(t) for t in y], slope_fd, rtol=1e-7)
+    np.testing.assert_allclose([beta_curvature(t) for t in y], curv_fd, rtol=1e-6)
+    assert beta(1.0) == beta_slope(1.0) == beta_curvature(1.0) == 0.0  # C^2 at y = 1 (dhat)
+    assert beta(1.0 - 1e-4) < 1e-11 and beta(0.0) == np.inf  # infinite at contact
+
+
+def _folded_ring(n=24, gap=0.6e-3):
+    """A ring squashed into a stadium: two straight walls ``gap`` (m) apart joined by half circles."""
+    half = n // 2
+    top = np.linspace(0.04, -0.04, half // 2)
+    x = []
+    arc = np.linspace(np.pi / 2, 3 * np.pi / 2, half // 2 + 2)[1:-1]
+    x += [(t, gap / 2) for t in top]
+    x += [(-0.04 + gap / 2 * np.cos(a), gap / 2 * np.sin(a)) for a in arc]
+    x += [(t, -gap / 2) for t in -top]
+    x += [(0.04 - gap / 2 * np.cos(a), -gap / 2 * np.sin(a)) for a in arc]
+    return np.array(x[:n])
+
+
+def _model_and_pairs(x, thickness=1e-3):
+    n = x.shape[0]
+    scene = Scene(rings=[Ring(n_nodes=n, pressure=None, thickness=thickness)], gravity=0.0)
+    model = build_model(scene)
+    ws = build_workspace(n)
+    bw = ws.barrier
+    count = find_pairs(x, x, model.rest_len[0], thickness, bw)
+    return model, ws, count
+
+
+def test_contact_jacobian_matches_finite_differences_of_the_force():
+    rng = np.random.default_rng(3)
+    x = _folded_ring() + rng.normal(scale=5e-5, size=(24, 2))
+    model, ws, count = _model_and_pairs(x)
+    bw = ws.barrier
+    kappa, dhat = 1e3, 1e-3
+    n = x.shape[0]
+
+    def force(y):
+        f = np.zeros((n, 2))
+        barrier_force(y, bw.pairs, count, kappa, dhat, f, bw)
+        return f.ravel()
+
+    assert count > 0 and np.abs(force(x)).max() > 0.0  # the walls touch
+    ws.band[:] = 0.0
+    rank = barrier_jacobian(x, bw.pairs, count, kappa, dhat, 1.0, ws.band, ws.pos, bw.u, bw.w, 0, bw)
+    assert 0 < rank <= 2 * n  # far wall parts coupled through low-rank columns
+    dense = band_to_dense(ws.band, ws.pos) + bw.u[:, :rank] @ bw.w[:, :rank].T
+    eps = 1e-9
+    fd = np.zeros((2 * n, 2 * n))
+    for k in range(2 * n):
+        dx = np.zeros(2 * n)
+        dx[k] = eps
+        fd[:, k] = -(force(x + dx.reshape(n, 2)) - force(x - dx.reshape(n, 2))) / (2 * eps)
+    scale = np.abs(fd).max()
+    np.testing.assert_allclose(dense, fd, atol=1e-6 * scale)
+    # and the force is minus the energy's gradient
+    e_fd = np.zeros(2 * n)
+    for k in range(2 * n):
+        dx = np.zeros(2 * n)
+        dx[k] = eps
+        plus = barrier_energy(x + dx.reshape(n, 2), bw.pairs, count, kappa, dhat)
+        minus = barrier_energy(x - dx.reshape(n, 2), bw.pairs, count, kappa, dhat)
+        e_fd[k] = -(plus - minus) / (2 * eps)
+    np.testing.assert_allclose(force(x), e_fd, atol=1e-6 * np.abs(e_fd).max())
+
+
+def test_ccd_catches_a_fast_crossing_that_a_discrete_test_misses():
+    # a node moving 1 m/s through a still edge in a 0.1 s step: 5 cm either side, so neither end
+    # state has it within dhat = 1 mm of the edge, and neither end state is crossed
+    pa, pb = np.array([0.5, 0.05]), np.array([0.5, -0.05])
+    aa = ab = np.array([0.0, 0.0])
+    ba = bb = np.array([1.0, 0.0])
+    dhat = 1e-3
+    assert point_edge_distance2(*pa, *aa, *ba) > dhat**2
+    assert point_edge_distance2(*pb, *ab, *bb) > dhat**2
+    assert point_edge_impact(pa, pb, aa, ab, ba, bb) == pytest.approx(0.5, rel=1e-14)
+    # a moving edge: a wall tip sweeps across a still node
+    t = point_edge_impact(np.array([0.5, 0.0]), np.array([0.5, 0.0]), np.array([0.0, -1.0]),
+                          np.array([0.0, 1.0]), np.array([1.0, -1.0]), np.array([1.0, 1.0]))  # fmt: skip
+    assert t == pytest.approx(0.5, rel=1e-14)
+    # passing beside the segment's end is no impact
+    assert point_edge_impact(np.array([1.5, 0.05]), np.array([1.5, -0.05]), aa, ab, ba, bb) == np.inf
+
+
+def test_ccd_over_a_ring_finds_the_first_wall_crossing():
+    x = _folded_ring(gap=4e-3)
+    n = x.shape[0]
+    moved = x.copy()
+    moved[: n // 4, 1] -= 8e-3  # the top wall pushed through the bottom wall
+    assert self_intersects(moved)
+    model, ws, _ = _model_and_pairs(x)
+    count = find_pairs(x, moved, model.rest_len[0], 1e-3, ws.barrier)
+    first = impact_fraction(x, moved, ws.barrier.pairs, count)
+    assert first == pytest.approx(0.5, abs=1e-12)  # top meets bottom half-way
+    assert not self_intersects(x + 0.8 * first * (moved - x))
+
+
+def test_a_ring_at_rest_has_no_candidate_pairs():
+    scene = Scene(rings=[Ring()], gravity=0.0)
+    model = build_model(scene)
+    x, _ = initial_state(scene)
+    ws = build_workspace(x.shape[1])
+    assert find_pairs(x[0], x[0], model.rest_len[0], model.thickness[0], ws.barrier) == 0
+
+
+def test_pairs_near_along_the_ring_are_excluded():
+    n, rest_len, dhat = 64, 1e-2, 2e-3
+    assert excluded(10, 10, n, rest_len, dhat) and excluded(10, 9, n, rest_len, dhat)  # its own edges
+    assert not excluded(10, 11, n, rest_len, dhat)  # the next edge, one rest length away
+    assert excluded(10, 11, n, 1e-3, dhat)  # unless that is within the arc exclusion
+    assert excluded(10, 63, n, rest_len, 0.5 * 64 * rest_len)  # within the arc exclusion
+    assert not excluded(10, 40, n, rest_len, dhat)
+
+
+def _min_pair_distance(x, rest_len, dhat):
+    n = x.shape[0]
+    return min(
+        np.sqrt(point_edge_distance2(*x[i], *x[j], *x[(j + 1) % n]))
+        for i in range(n)
+        for j in range(n)
+        if not excluded(i, j, n, rest_len, dhat)
+    )
+
+
+def test_a_soft_empty_ring_comes_to_rest_folded():
+    h = 2e-3
+    ring = Ring(pressure=None, youngs_modulus=1e5, thickness=h, n_nodes=64, position=(0.0, 0.1005))
+    scene = Scene(rings=[ring], grounds=[Ground()], damping=20.0, dt=1e-3, adaptive=True)
+    traj = simulate(scene, 1.0, output_dt=0.05)
+    x = traj.x[-1, 0]
+    assert x[:, 1].max() < 8 * h  # squashed flat: top wall on the bottom wall
+    rest_len = build_model(scene).rest_len[0]
+    assert 0.0 < _min_pair_distance(x, rest_len, h) < h  # held apart by the barrier, inside dhat
+    kinetic = traj.energy()["kinetic"][:, 0]
+    mass = build_model(scene).node_mass[0] * 64
+    assert kinetic[-4:].max() < 1e-5 * mass * 9.81 * 2 * ring.radius  # at rest
+    assert not any(self_intersects(xk[0]) for xk in traj.x)
+
+
+@pytest.mark.parametrize("thickness", [1e-3, 2e-3])
+def test_a_thin_walled_empty_ring_dropped_at_15_m_s_completes(thickness):
+    ring = Ring(pressure=None, thickness=thickness, velocity=(0.0, -15.0), position=(0.0, 0.12))
+    scene = Scene(rings=[ring], grounds=[Ground()])
+    traj = simulate(scene, 0.1, output_dt=1e-3)
+    assert traj.t[-1] == pytest.approx(0.1)
+    assert not any(self_intersects(xk[0]) for xk in traj.x)
+    energy = traj.energy()["total"][:, 0]
+    assert energy.max() <= energy[0] * (1 + 1e-9)  # the barrier is a potential: no energy made
+
+
+def test_the_rolling_rings_of_figure_8_complete_with_walls_of_2_5_mm():
+    # the scene library's rolling rings (figure 8) with the intended wall, h = 2.5 mm instead of
+    # 5 mm: the two softest sag until top meets bottom and roll folded
+    slope, radius = 0.15, 0.1
+    normal = np.array([-np.sin(slope), np.cos(slope)])
+    heights = []
+    for modulus in (2e6, 4e6, 6e6, 8e6):
+        centre = tuple((radius + 0.003) * normal)
+        ring = Ring(radius=radius, thickness=2.5e-3, youngs_modulus=modulus, pressure=None, position=centre)
+        scene = Scene(rings=[ring], grounds=[Ground(angle=slope, friction=0.8)], damping=20.0, dt=1e-2,
+                      adaptive=True, impulse_tol=2e-3, newton_tol=1e-9, rho_infinity=0.3)  # fmt: skip
+        traj = simulate(scene, 2.0, output_dt=5e-3)
+        assert traj.t[-1] == pytest.approx(2.0)
+        assert not any(self_intersects(xk[0]) for xk in traj.x)
+        up = traj.x[:, 0] @ normal
+        heights.append(np.mean(up.max(axis=1)[-100:] - up.min(axis=1)[-100:]))
+    assert np.all(np.diff(heights) > 0.0)  # the rolling shape is taller the stiffer the wall
+    assert heights[0] < 0.3 * 2 * radius  # the softest rolls folded
