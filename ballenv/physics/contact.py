@@ -73,6 +73,24 @@ def constrain_residual(grounds, active, x1, ve, res, node_mass, c_mass, eps, rea
             res[2 * i], res[2 * i + 1] = row_t, row_n
 
 
+@kernel(inline="always")
+def sliding(grounds, g, ve, i, eps):
+    """Ground ``g``'s normal ``(nx, ny)``, tangent ``(tx, ty) = (-ny, nx)`` and friction ``mu``, and
+    the regularised sliding direction ``s = vt / sqrt(vt^2 + eps^2)`` of node ``i``'s velocity
+    ``ve[i]`` (``vt`` along t, m/s) with its derivative ``ds/dvt`` (s/m); ``s = ds = 0`` without
+    friction."""
+    nx, ny, mu = grounds[g, 0], grounds[g, 1], grounds[g, 3]
+    tx, ty = -ny, nx
+    s = 0.0
+    ds = 0.0
+    if mu > 0.0:
+        vt = tx * ve[i, 0] + ty * ve[i, 1]
+        q = vt * vt + eps * eps
+        s = vt / math.sqrt(q)
+        ds = eps * eps / (q * math.sqrt(q))
+    return nx, ny, tx, ty, mu, s, ds
+
+
 @kernel
 def constrain_jacobian(grounds, active, ve, reaction, band, pos, u, rank, node_mass, c_mass, c_v, eps):
     """Apply the row combinations of :func:`constrain_residual` to the band and to the rows of the
@@ -83,15 +101,7 @@ def constrain_jacobian(grounds, active, ve, reaction, band, pos, u, rank, node_m
         g = active[i]
         if g == FREE:
             continue
-        nx, ny, mu = grounds[g, 0], grounds[g, 1], grounds[g, 3]
-        tx, ty = -ny, nx
-        s = 0.0
-        ds = 0.0
-        if mu > 0.0:
-            vt = tx * ve[i, 0] + ty * ve[i, 1]
-            q = vt * vt + eps * eps
-            s = vt / math.sqrt(q)
-            ds = eps * eps / (q * math.sqrt(q))
+        nx, ny, tx, ty, mu, s, ds = sliding(grounds, g, ve, i, eps)
         ax = tx + mu * s * nx
         ay = ty + mu * s * ny
         p = 2 * pos[i]
@@ -113,30 +123,19 @@ def constrain_jacobian(grounds, active, ve, reaction, band, pos, u, rank, node_m
         band[row_t, w + p + 1 - row_t] += extra * ty
         band[row_n, w + p - row_n] = c_mass * node_mass * nx
         band[row_n, w + p + 1 - row_n] = c_mass * node_mass * ny
-        for k in range(rank):
-            ut = ax * u[2 * i, k] + ay * u[2 * i + 1, k]
-            if swap:
-                u[2 * i, k] = 0.0
-                u[2 * i + 1, k] = ut
-            else:
-                u[2 * i, k] = ut
-                u[2 * i + 1, k] = 0.0
+    constrain_low_rank_rows(grounds, active, ve, u, 0, rank, eps)
 
 
 @kernel
 def constrain_low_rank_rows(grounds, active, ve, u, first, last, eps):
     """Apply the row combinations of :func:`constrain_residual` to columns ``first .. last - 1``
-    of a low-rank factor ``u`` (natural order), as :func:`constrain_jacobian` does to its own."""
+    of a low-rank factor ``u`` (natural order): the effects' columns in :func:`constrain_jacobian`,
+    the self-contact barrier's in the Newton step."""
     for i in range(active.shape[0]):
         g = active[i]
         if g == FREE:
             continue
-        nx, ny, mu = grounds[g, 0], grounds[g, 1], grounds[g, 3]
-        tx, ty = -ny, nx
-        s = 0.0
-        if mu > 0.0:
-            vt = tx * ve[i, 0] + ty * ve[i, 1]
-            s = vt / math.sqrt(vt * vt + eps * eps)
+        nx, ny, tx, ty, mu, s, _ = sliding(grounds, g, ve, i, eps)
         ax = tx + mu * s * nx
         ay = ty + mu * s * ny
         swap = abs(nx) > abs(ny)
