@@ -103,7 +103,7 @@ def step_ring(model, solver, r, state, v0, trial, h, ws):
     copy_into(trial.active[r], state.active[r])
     its = newton_ring(
         model, solver, r, state.x[r], v0[r], state.a[r], h, trial.x[r], trial.v[r], trial.a[r], ws,
-        trial.active[r],
+        trial.active[r], ws.barrier,
     )  # fmt: skip
     if its < 0:
         return -REJECT_NEWTON
