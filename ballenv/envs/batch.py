@@ -94,7 +94,7 @@ REWARD_AT_MARGIN = 0.1
 REWARD_SCALE = math.sqrt(-2.0 * math.log(REWARD_AT_MARGIN))
 NO_OUTPUT = 1e300  # output interval of advance(): record only at the end of the control step
 EVENT_ROWS = 32
-CHUNKS_PER_THREAD = 8  # a threaded step hands out contiguous chunks of envs to whichever thread is free
+ENVS_PER_LINE = 8  # envs of a float64 or int64 per-env array in one 64-byte cache line
 
 
 class Task(NamedTuple):
@@ -449,12 +449,12 @@ class BallBatch:
     ``obs`` (E, D) float32 holds the observations clipped to ``[low, high]``; ``task.reward`` the
     reward and its terms, ``task.end`` how each episode ended (``END_*``).
 
-    With ``threads`` > 1 a step is cut into ``CHUNKS_PER_THREAD * threads`` contiguous chunks of
-    envs, each a :func:`step_batch` call (without the GIL) taken by whichever thread (the caller's
-    and ``threads - 1`` others) is free, with that thread's scratch: envs cost unequal and changing
+    With ``threads`` > 1 a step is cut into contiguous chunks of envs (:func:`guided_chunks`), each a
+    :func:`step_batch` call (without the GIL) taken by whichever thread (the caller's and
+    ``threads - 1`` others) is free, with that thread's scratch: envs cost unequal and changing
     amounts (a bounce, a strike), so fixed shares would leave one thread waiting. Chunks write
-    disjoint, contiguous rows (no cache line written by two threads but at chunk ends) and scratch
-    carries nothing from one env to the next: every env's numbers are those of one thread, to the bit."""
+    disjoint, contiguous rows and scratch carries nothing from one env to the next: every env's
+    numbers are those of one thread, to the bit."""
 
     def __init__(
         self,
@@ -515,9 +515,9 @@ class BallBatch:
                 (build_workspace(self.n_nodes, barrier=barrier), np.zeros(self.n_nodes, dtype=np.int64))
                 for _ in range(self.threads - 1)
             ]
-            chunks = min(n_envs, CHUNKS_PER_THREAD * self.threads)
-            chunk = np.arange(n_envs) * chunks // n_envs
-            self._chunks = chunk[None, :] == np.arange(chunks)[:, None]
+            bounds = guided_chunks(n_envs, self.threads)
+            envs = np.arange(n_envs)
+            self._chunks = np.array([(envs >= a) & (envs < b) for a, b in itertools.pairwise(bounds)])
         self.low = np.asarray(low, dtype=np.float64)
         self.high = np.asarray(high, dtype=np.float64)
         self.raw = np.zeros((n_envs, observation_size(self.n_nodes, self.task.mode)))
@@ -587,6 +587,23 @@ class BallBatch:
         if self._pool is not None:
             self._pool.shutdown()
             self._pool = None
+
+
+def guided_chunks(n_envs: int, threads: int) -> list[int]:
+    """Boundaries ``[0, b_1, ..., n_envs]`` of the chunks a threaded step hands out, in the order
+    they are drawn: each chunk is ``1 / (2 threads)`` of the envs still left (guided scheduling), so
+    the first are large (few calls, each unboxing the step's ~100 arrays) and the last single envs
+    (a thread finishing early has small pieces left to take instead of waiting for the other's
+    last large one). While at least ``ENVS_PER_LINE`` envs are left, chunks are whole multiples of
+    it: the per-env arrays' cache lines are then written by one thread only."""
+    bounds = [0]
+    while bounds[-1] < n_envs:
+        left = n_envs - bounds[-1]
+        size = max(1, left // (2 * threads))
+        if size >= ENVS_PER_LINE:
+            size -= size % ENVS_PER_LINE
+        bounds.append(bounds[-1] + size)
+    return bounds
 
 
 def compiled_entry(dispatcher: Any, args: tuple[Any, ...]) -> Callable[..., None]:
