@@ -105,6 +105,8 @@ class BarrierWorkspace(NamedTuple):
     z: np.ndarray  # (2N, K + 1): B^-1 [u, rhs]
     cap: np.ndarray  # (K, K)
     coef: np.ndarray  # (K,)
+    clear_x: np.ndarray  # (N, 2) m: the last positions found with no pair within dhat
+    clear_key: np.ndarray  # (2,): their rest length and dhat (m); NaN: none found yet
 
 
 class Workspace(NamedTuple):
@@ -297,6 +299,8 @@ def build_barrier_workspace(n_nodes):
         z=np.zeros((n2, k + 1)),
         cap=np.zeros((k, k)),
         coef=np.zeros(k),
+        clear_x=np.zeros((n_nodes, 2)),
+        clear_key=np.full(2, np.nan),
     )
 
 

@@ -15,6 +15,7 @@ from ballenv.physics.barrier import (
     excluded,
     find_pairs,
     impact_fraction,
+    near_pairs,
     point_edge_derivatives,
     point_edge_distance2,
     point_edge_impact,
@@ -163,6 +164,26 @@ def test_a_ring_at_rest_has_no_candidate_pairs():
     x, _ = initial_state(scene)
     ws = build_workspace(x.shape[1])
     assert find_pairs(x[0], x[0], model.rest_len[0], model.thickness[0], ws.barrier) == 0
+
+
+def test_near_pairs_remembers_clear_positions_and_nothing_else():
+    scene = Scene(rings=[Ring()], gravity=0.0)
+    model = build_model(scene)
+    x, _ = initial_state(scene)
+    x = x[0].copy()
+    bw = build_workspace(x.shape[0]).barrier
+    rest_len, dhat = model.rest_len[0], model.thickness[0]
+    assert near_pairs(x, rest_len, dhat, bw) == 0
+    assert np.array_equal(bw.clear_x, x) and tuple(bw.clear_key) == (rest_len, dhat)
+    squashed = x.copy()
+    squashed[:, 1] = x[0, 1] + 0.02 * (x[:, 1] - x[0, 1])  # top and bottom within dhat
+    near = near_pairs(squashed, rest_len, dhat, bw)
+    assert near > 0 and np.array_equal(bw.clear_x, x)  # swept, and not remembered
+    assert near_pairs(x, rest_len, dhat, bw) == 0
+    # the remembered positions are what is compared: planted, they answer without a sweep
+    bw.clear_x[:] = squashed
+    assert near_pairs(squashed, rest_len, dhat, bw) == 0
+    assert near_pairs(squashed, rest_len, 1.01 * dhat, bw) == near  # but only with their dhat
 
 
 def test_pairs_near_along_the_ring_are_excluded():
