@@ -470,8 +470,8 @@ class BallBatch:
         self.n_nodes = scene.rings[0].n_nodes
         self.model = _tiled_model(build_model(scene), n_envs)
         self.solver = build_solver(scene)
-        barrier = bool(self.model.self_barrier)  # None in its place: the step compiles without it
-        self.ws = build_workspace(self.n_nodes, barrier=barrier)
+        barrier = bool(self.model.self_barrier)
+        self.ws = self._scratch_workspace(barrier)
         self.state = empty_state(n_envs, self.n_nodes)
         self.trial = empty_state(n_envs, self.n_nodes)
         self.clocks = np.zeros((n_envs, N_CLOCK))
@@ -512,7 +512,10 @@ class BallBatch:
         if self.threads > 1:
             self._pool = ThreadPoolExecutor(self.threads - 1, thread_name_prefix="ballenv")
             self._scratch = [(self.ws, self.nodes)] + [
-                (build_workspace(self.n_nodes, barrier=barrier), np.zeros(self.n_nodes, dtype=np.int64))
+                (
+                    build_workspace(self.n_nodes, barrier=barrier, ring_pairs=False),
+                    np.zeros(self.n_nodes, dtype=np.int64),
+                )
                 for _ in range(self.threads - 1)
             ]
             bounds = guided_chunks(n_envs, self.threads)
@@ -526,6 +529,11 @@ class BallBatch:
         self._step_batch: Callable[..., None] | None = (
             None  # the compiled entry point of the step call, once known
         )
+
+    def _scratch_workspace(self, barrier: bool) -> Workspace:
+        """A thread's scratch: one ring, with the barrier's if the scene has it, never ring pairs
+        (the envs' rings never meet). None in their places: the step compiles none of their code."""
+        return build_workspace(self.n_nodes, barrier=barrier, ring_pairs=False)
 
     def reset(
         self, e: int, centre: ArrayLike, velocity: ArrayLike, phase: float, target: float, pressure: float

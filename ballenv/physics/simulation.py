@@ -250,7 +250,9 @@ class Simulation:
         self.model = build_model(scene, effects)
         self.solver = build_solver(scene)
         n_rings, n_nodes = len(scene.rings), scene.rings[0].n_nodes
-        self.ws = build_workspace(n_nodes, n_rings, effects, barrier=self.model.self_barrier)
+        self.ws = build_workspace(
+            n_nodes, n_rings, effects, barrier=self.model.self_barrier, ring_pairs=self.model.collide
+        )
         self.state = empty_state(n_rings, n_nodes)
         self.trial = empty_state(n_rings, n_nodes)
         shape = (n_rings, n_nodes, 2)
