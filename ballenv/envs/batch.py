@@ -25,7 +25,7 @@ from ..physics.contact import FREE
 from ..physics.effects.gas import ring_pressure
 from ..physics.geometry import centre_of_mass
 from ..physics.integrator import build_solver
-from ..physics.jit import kernel
+from ..physics.jit import kernel, python_entry
 from ..physics.layout import (
     CLOCK_H,
     COUNT_EVENTS,
@@ -619,6 +619,7 @@ def compiled_entry(dispatcher: Any, args: tuple[Any, ...]) -> Callable[..., None
     (compiled, or loaded from the cache, on first use). Calling it skips the dispatcher's typing of
     the arguments: about 13 us per call for the ~100 arrays of a step (7 us are left, for unboxing
     them). The caller must pass arguments of exactly these types (dtype, dimensions, layout)."""
+    dispatcher = python_entry(dispatcher)
     signature = tuple(dispatcher.typeof_pyval(a) for a in args)
     if signature not in dispatcher.overloads:
         dispatcher.compile(signature)
