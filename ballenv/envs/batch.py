@@ -25,7 +25,7 @@ from ..physics.contact import FREE
 from ..physics.effects.gas import ring_pressure
 from ..physics.geometry import centre_of_mass
 from ..physics.integrator import build_solver
-from ..physics.jit import kernel
+from ..physics.jit import kernel, python_entry
 from ..physics.layout import (
     CLOCK_H,
     COUNT_EVENTS,
@@ -94,7 +94,7 @@ REWARD_AT_MARGIN = 0.1
 REWARD_SCALE = math.sqrt(-2.0 * math.log(REWARD_AT_MARGIN))
 NO_OUTPUT = 1e300  # output interval of advance(): record only at the end of the control step
 EVENT_ROWS = 32
-CHUNKS_PER_THREAD = 8  # a threaded step hands out contiguous chunks of envs to whichever thread is free
+ENVS_PER_LINE = 8  # envs of a float64 or int64 per-env array in one 64-byte cache line
 
 
 class Task(NamedTuple):
@@ -449,12 +449,12 @@ class BallBatch:
     ``obs`` (E, D) float32 holds the observations clipped to ``[low, high]``; ``task.reward`` the
     reward and its terms, ``task.end`` how each episode ended (``END_*``).
 
-    With ``threads`` > 1 a step is cut into ``CHUNKS_PER_THREAD * threads`` contiguous chunks of
-    envs, each a :func:`step_batch` call (without the GIL) taken by whichever thread (the caller's
-    and ``threads - 1`` others) is free, with that thread's scratch: envs cost unequal and changing
+    With ``threads`` > 1 a step is cut into contiguous chunks of envs (:func:`guided_chunks`), each a
+    :func:`step_batch` call (without the GIL) taken by whichever thread (the caller's and
+    ``threads - 1`` others) is free, with that thread's scratch: envs cost unequal and changing
     amounts (a bounce, a strike), so fixed shares would leave one thread waiting. Chunks write
-    disjoint, contiguous rows (no cache line written by two threads but at chunk ends) and scratch
-    carries nothing from one env to the next: every env's numbers are those of one thread, to the bit."""
+    disjoint, contiguous rows and scratch carries nothing from one env to the next: every env's
+    numbers are those of one thread, to the bit."""
 
     def __init__(
         self,
@@ -470,8 +470,8 @@ class BallBatch:
         self.n_nodes = scene.rings[0].n_nodes
         self.model = _tiled_model(build_model(scene), n_envs)
         self.solver = build_solver(scene)
-        barrier = bool(self.model.self_barrier)  # None in its place: the step compiles without it
-        self.ws = build_workspace(self.n_nodes, barrier=barrier)
+        barrier = bool(self.model.self_barrier)
+        self.ws = self._scratch_workspace(barrier)
         self.state = empty_state(n_envs, self.n_nodes)
         self.trial = empty_state(n_envs, self.n_nodes)
         self.clocks = np.zeros((n_envs, N_CLOCK))
@@ -512,12 +512,15 @@ class BallBatch:
         if self.threads > 1:
             self._pool = ThreadPoolExecutor(self.threads - 1, thread_name_prefix="ballenv")
             self._scratch = [(self.ws, self.nodes)] + [
-                (build_workspace(self.n_nodes, barrier=barrier), np.zeros(self.n_nodes, dtype=np.int64))
+                (
+                    build_workspace(self.n_nodes, barrier=barrier, ring_pairs=False),
+                    np.zeros(self.n_nodes, dtype=np.int64),
+                )
                 for _ in range(self.threads - 1)
             ]
-            chunks = min(n_envs, CHUNKS_PER_THREAD * self.threads)
-            chunk = np.arange(n_envs) * chunks // n_envs
-            self._chunks = chunk[None, :] == np.arange(chunks)[:, None]
+            bounds = guided_chunks(n_envs, self.threads)
+            envs = np.arange(n_envs)
+            self._chunks = np.array([(envs >= a) & (envs < b) for a, b in itertools.pairwise(bounds)])
         self.low = np.asarray(low, dtype=np.float64)
         self.high = np.asarray(high, dtype=np.float64)
         self.raw = np.zeros((n_envs, observation_size(self.n_nodes, self.task.mode)))
@@ -526,6 +529,11 @@ class BallBatch:
         self._step_batch: Callable[..., None] | None = (
             None  # the compiled entry point of the step call, once known
         )
+
+    def _scratch_workspace(self, barrier: bool) -> Workspace:
+        """A thread's scratch: one ring, with the barrier's if the scene has it, never ring pairs
+        (the envs' rings never meet). None in their places: the step compiles none of their code."""
+        return build_workspace(self.n_nodes, barrier=barrier, ring_pairs=False)
 
     def reset(
         self, e: int, centre: ArrayLike, velocity: ArrayLike, phase: float, target: float, pressure: float
@@ -589,11 +597,29 @@ class BallBatch:
             self._pool = None
 
 
+def guided_chunks(n_envs: int, threads: int) -> list[int]:
+    """Boundaries ``[0, b_1, ..., n_envs]`` of the chunks a threaded step hands out, in the order
+    they are drawn: each chunk is ``1 / (2 threads)`` of the envs still left (guided scheduling), so
+    the first are large (few calls, each unboxing the step's ~100 arrays) and the last single envs
+    (a thread finishing early has small pieces left to take instead of waiting for the other's
+    last large one). While at least ``ENVS_PER_LINE`` envs are left, chunks are whole multiples of
+    it: the per-env arrays' cache lines are then written by one thread only."""
+    bounds = [0]
+    while bounds[-1] < n_envs:
+        left = n_envs - bounds[-1]
+        size = max(1, left // (2 * threads))
+        if size >= ENVS_PER_LINE:
+            size -= size % ENVS_PER_LINE
+        bounds.append(bounds[-1] + size)
+    return bounds
+
+
 def compiled_entry(dispatcher: Any, args: tuple[Any, ...]) -> Callable[..., None]:
     """The compiled entry point of numba ``dispatcher`` for arguments of the types of ``args``
     (compiled, or loaded from the cache, on first use). Calling it skips the dispatcher's typing of
     the arguments: about 13 us per call for the ~100 arrays of a step (7 us are left, for unboxing
     them). The caller must pass arguments of exactly these types (dtype, dimensions, layout)."""
+    dispatcher = python_entry(dispatcher)
     signature = tuple(dispatcher.typeof_pyval(a) for a in args)
     if signature not in dispatcher.overloads:
         dispatcher.compile(signature)

@@ -42,7 +42,7 @@ first impact, so no trial state passes a wall through another, however far it mo
 import math
 
 from .cyclic import next_node
-from .jit import kernel
+from .jit import copy_into, kernel
 from .linalg import band_add_block
 
 ARC_EXCLUSION = 2.0  # pairs nearer along the ring (rest arc length) than this many dhat are skipped
@@ -256,9 +256,16 @@ def find_pairs(xa, xb, rest_len, dhat, bw):
 @kernel
 def near_pairs(x, rest_len, dhat, bw):
     """How many (node, edge) pairs of one ring at ``x`` (N, 2) m are closer than ``dhat`` (m);
-    ``-1`` if the candidates do not fit ``bw.pairs``."""
+    ``-1`` if the candidates do not fit ``bw.pairs``.
+
+    The answer depends on ``x``, ``rest_len`` and ``dhat`` only, and a step asks it three times of
+    the same positions where no wall part comes near (the end of a step, its energy, the start of
+    the next): positions found clear are kept (``bw.clear_x``, ``bw.clear_key``), and asking again
+    of the same positions, bit for bit, costs a comparison instead of a sweep."""
+    if _known_clear(x, rest_len, dhat, bw):
+        return 0
     count = find_pairs(x, x, rest_len, dhat, bw)
-    if count <= 0:
+    if count < 0:
         return count
     n = x.shape[0]
     near = 0
@@ -267,7 +274,24 @@ def near_pairs(x, rest_len, dhat, bw):
         q = next_node(j, n)
         if point_edge_distance2(x[i, 0], x[i, 1], x[j, 0], x[j, 1], x[q, 0], x[q, 1]) < dhat * dhat:
             near += 1
+    if near == 0:
+        copy_into(bw.clear_x, x)
+        bw.clear_key[0] = rest_len
+        bw.clear_key[1] = dhat
     return near
+
+
+@kernel(inline="always")
+def _known_clear(x, rest_len, dhat, bw):
+    """Whether ``x`` with ``rest_len`` and ``dhat`` are the positions :func:`near_pairs` last found
+    clear (compared bit for bit)."""
+    if bw.clear_key[0] != rest_len or bw.clear_key[1] != dhat:
+        return False
+    clear = bw.clear_x
+    for i in range(x.shape[0]):
+        if x[i, 0] != clear[i, 0] or x[i, 1] != clear[i, 1]:
+            return False
+    return True
 
 
 # ---------------------------------------------------------------------- continuous detection

@@ -392,9 +392,10 @@ def _self_contacts(x, pred, edge, v, h, r, delta, relax, node_mass, kicked):
 
 
 @kernel
-def collision_impulses(x, v, h, thickness, node_mass, rings, self_contact, cw, kicked, kinetic_change):
+def collision_impulses(x, v, h, thickness, node_mass, rings, self_contact, cw, kicked, kinetic_change, rw):
     """Velocities ``kicked`` (R, N, 2, m/s) after the collision impulses of a step of size ``h``
-    (s) from nodes ``x`` (m) moving at ``v`` (m/s): between rings if ``rings``, within each ring if
+    (s) from nodes ``x`` (m) moving at ``v`` (m/s): between rings if ``rings`` (``rw``: the
+    collision scratch ``cw`` once more, None where rings cannot collide), within each ring if
     ``self_contact``; see the module docstring. ``kinetic_change[r]`` receives the change of ring
     r's kinetic energy (J). Returns the number of contacts (found on the predicted positions
     ``x + h v``, kept in ``cw.predicted``)."""
@@ -407,29 +408,7 @@ def collision_impulses(x, v, h, thickness, node_mass, rings, self_contact, cw, k
     relax = min(1.0, h / RELAXATION_TIME)
     count = 0
     if rings:
-        for r in range(x.shape[0]):
-            cw.orientation[r] = orientation(pred[r])
-        count = find_contacts(pred, thickness, cw)
-        for c in range(count):
-            row = cw.contacts[c]
-            a, i, b, j = int(row[0]), int(row[1]), int(row[2]), int(row[3])
-            nx, ny = outward_normal(pred[b], j, row[4], cw.orientation[b])
-            _kick(
-                v,
-                h,
-                node_mass,
-                a,
-                i,
-                b,
-                j,
-                row[4],
-                nx,
-                ny,
-                row[5],
-                thickness[a] + thickness[b],
-                relax,
-                kicked,
-            )
+        count = ring_kicks(v, h, thickness, node_mass, relax, kicked, rw)
     if self_contact:
         for r in range(x.shape[0]):
             count += _self_contacts(
@@ -445,8 +424,30 @@ def collision_impulses(x, v, h, thickness, node_mass, rings, self_contact, cw, k
 
 
 @kernel
+def ring_kicks(v, h, thickness, node_mass, relax, kicked, rw):
+    """The impulses between rings on the predicted positions ``rw.predicted`` into ``kicked`` (see
+    :func:`collision_impulses`); returns their number. Nothing (0) without ``rw``."""
+    if rw is None:
+        return 0
+    pred = rw.predicted
+    for r in range(pred.shape[0]):
+        rw.orientation[r] = orientation(pred[r])
+    count = find_contacts(pred, thickness, rw)
+    for c in range(count):
+        row = rw.contacts[c]
+        a, i, b, j = int(row[0]), int(row[1]), int(row[2]), int(row[3])
+        nx, ny = outward_normal(pred[b], j, row[4], rw.orientation[b])
+        reach = thickness[a] + thickness[b]
+        _kick(v, h, node_mass, a, i, b, j, row[4], nx, ny, row[5], reach, relax, kicked)
+    return count
+
+
+@kernel
 def rings_intrude(x, thickness, cw):
-    """True if a node of one ring is inside another ring's centreline polygon."""
+    """True if a node of one ring is inside another ring's centreline polygon (False without
+    ``cw``, the ring-ring scratch ``Workspace.ring_pairs``)."""
+    if cw is None:
+        return False
     count = find_contacts(x, thickness, cw)
     for c in range(count):
         if cw.contacts[c, 5] < 0.0:
@@ -457,7 +458,8 @@ def rings_intrude(x, thickness, cw):
 @kernel
 def collision_step_limit(x, v, thickness, h, cw):
     """Largest step (s, at most ``h``) in which no node can move more than half the contact
-    distance into a ring it could reach.
+    distance into a ring it could reach; ``h`` itself without ``cw`` (the ring-ring scratch
+    ``Workspace.ring_pairs``, None where rings cannot collide).
 
     For each pair whose boxes, grown by the contact distance plus the distance its fastest node
     covers in ``h``, overlap: the gap ``G`` between the tight boxes bounds every node distance from
@@ -465,6 +467,8 @@ def collision_step_limit(x, v, thickness, h, cw):
     a ring's largest node speed relative to its centre of mass: spin and deformation). The step is
     kept below ``(max(G - delta, 0) + delta / 2) / u``.
     """
+    if cw is None:
+        return h
     n_rings, n = x.shape[0], x.shape[1]
     for r in range(n_rings):
         cx = cy = vx = vy = 0.0

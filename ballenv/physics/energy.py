@@ -12,7 +12,7 @@ actuation and collision impulses gave it since). The energy parts come from the 
 import math
 
 from .assembly import gravity_column, ring_energy
-from .barrier import barrier_energy, find_pairs, reach, stiffness
+from .barrier import barrier_energy, find_pairs, near_pairs, reach, stiffness
 from .contact import rest_on_grounds
 from .geometry import centre_of_mass
 from .jit import kernel
@@ -41,9 +41,9 @@ def self_contact_energy(model, r, x, bw):
     ``dhat`` (then exactly nothing is added), or without the barrier's workspace (``bw`` None)."""
     if bw is None:
         return 0.0
+    if near_pairs(x, model.rest_len[r], reach(model, r), bw) == 0:
+        return 0.0  # (no sweep where the step's end was found clear)
     count = find_pairs(x, x, model.rest_len[r], reach(model, r), bw)
-    if count == 0:
-        return 0.0
     if count < 0:
         return math.inf
     return barrier_energy(x, bw.pairs, count, stiffness(model, r), reach(model, r))

@@ -105,6 +105,8 @@ class BarrierWorkspace(NamedTuple):
     z: np.ndarray  # (2N, K + 1): B^-1 [u, rhs]
     cap: np.ndarray  # (K, K)
     coef: np.ndarray  # (K,)
+    clear_x: np.ndarray  # (N, 2) m: the last positions found with no pair within dhat
+    clear_key: np.ndarray  # (2,): their rest length and dhat (m); NaN: none found yet
 
 
 class Workspace(NamedTuple):
@@ -127,6 +129,7 @@ class Workspace(NamedTuple):
     energy_tally: np.ndarray  # (TALLY.size,) what the last trial step's energy budget saw (layout.TALLY)
     collision: CollisionWorkspace
     barrier: BarrierWorkspace | None  # None: the model has no self-contact barrier
+    ring_pairs: CollisionWorkspace | None  # ``collision`` again where rings collide, else None
 
 
 class State(NamedTuple):
@@ -245,12 +248,15 @@ def ground_array(grounds):
     return out
 
 
-def build_workspace(n_nodes, n_rings=1, effects=EFFECTS, barrier=True):
+def build_workspace(n_nodes, n_rings=1, effects=EFFECTS, barrier=True, ring_pairs=True):
     """Scratch arrays for one ring's Newton solve and the scene's collision detection, allocated
-    once per simulation (``effects``: the model's, for the size of the energy table; ``barrier``:
-    the self-contact barrier's scratch, or None in its place for a model without it, whose
-    compiled step then holds none of the barrier's code)."""
+    once per simulation (``effects``: the model's, for the size of the energy table). ``barrier``:
+    the self-contact barrier's scratch, or None in its place for a model without it; ``ring_pairs``:
+    the collision scratch once more as ``Workspace.ring_pairs`` (the ring-ring code's), or None
+    for a model whose rings cannot collide. A step compiled with None in either place holds none of
+    that code (numba prunes ``if ... is None`` on an argument before typing)."""
     n2 = 2 * n_nodes
+    collision = build_collision_workspace(n_rings, n_nodes)
     return Workspace(
         pos=zigzag_positions(n_nodes),
         band=np.zeros((n2, BAND_COLUMNS)),
@@ -269,8 +275,9 @@ def build_workspace(n_nodes, n_rings=1, effects=EFFECTS, barrier=True):
         friction=np.zeros(n_nodes),
         energy=np.zeros(len(energy_parts(effects))),
         energy_tally=np.zeros(TALLY.size),
-        collision=build_collision_workspace(n_rings, n_nodes),
+        collision=collision,
         barrier=build_barrier_workspace(n_nodes) if barrier else None,
+        ring_pairs=collision if ring_pairs else None,
     )
 
 
@@ -297,6 +304,8 @@ def build_barrier_workspace(n_nodes):
         z=np.zeros((n2, k + 1)),
         cap=np.zeros((k, k)),
         coef=np.zeros(k),
+        clear_x=np.zeros((n_nodes, 2)),
+        clear_key=np.full(2, np.nan),
     )
 
 

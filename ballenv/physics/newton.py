@@ -267,10 +267,11 @@ def backtrack(ws, lam):
 
 
 @kernel
-def newton_ring(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active):
+def newton_ring(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active, bw):
     """Solve one implicit step of ring ``r`` (:func:`newton_iterate`); ``x1, v1, a1`` receive the
     new state, ``active`` the step's contact set. Returns the number of Newton corrections (>= 0),
-    or ``FAILED``.
+    or ``FAILED``. ``bw`` is the self-contact barrier's workspace (``ws.barrier``; None: a scene
+    without the barrier, and numba then compiles only the plain step).
 
     With the self-contact barrier (``model.self_barrier``): a step that starts with no
     pair of the ring within ``dhat`` is first solved without it; if it ends with none either (or
@@ -280,15 +281,9 @@ def newton_ring(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active):
     correction are cut before their first impact (:func:`barrier_filter`), so no iterate passes a
     wall through another.
     """
-    if not model.self_barrier:
-        return newton_iterate(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active)
-    return newton_with_barrier(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active, ws.barrier)
-
-
-@kernel
-def newton_with_barrier(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active, bw):
-    """:func:`newton_ring` with the self-contact barrier's workspace ``bw`` (None: the plain step)."""
     if bw is None:
+        return newton_iterate(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active)
+    if not model.self_barrier:
         return newton_iterate(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active)
     rest_len, dhat = model.rest_len[r], reach(model, r)
     its = 0
@@ -304,7 +299,7 @@ def newton_with_barrier(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active,
     return FAILED if safe < 0 else safe + its
 
 
-@kernel
+@kernel(inline="always")
 def newton_iterate(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active):
     """Solve one implicit step of ring ``r``; ``x1, v1, a1`` receive the new state.
 

@@ -27,6 +27,7 @@ from .actuation import apply_impulse, set_rest_pressure
 from .assembly import ENERGY_PARTS, ring_energy
 from .collision import find_contacts, self_intersects
 from .effects import EFFECTS, scene_effects
+from .energy import self_contact_energy
 from .events import event_list
 from .geometry import polygon_area
 from .integrator import build_solver
@@ -59,7 +60,16 @@ from .layout import (
     STATUS_IMPULSE_AT_DT_MIN,
     STATUS_STEP_TOO_SMALL,
 )
-from .model import Model, Recording, Workspace, build_model, build_workspace, empty_recording, empty_state
+from .model import (
+    Model,
+    Recording,
+    Workspace,
+    build_barrier_workspace,
+    build_model,
+    build_workspace,
+    empty_recording,
+    empty_state,
+)
 from .scene import Scene, check_gauge_pressure, check_real, check_vector
 from .stepper import advance, initial_state_values, record
 
@@ -149,7 +159,8 @@ class Trajectory:
     def energy(self) -> dict[str, NDArray[np.float64]]:
         """Energy (J) per record and ring: dict of (T, n_rings) arrays.
 
-        Keys: kinetic, stretching, bending, gas (the gas-law potential), gravity, total. Computed with
+        Keys: kinetic, stretching, bending, gas (the gas-law potential), gravity, with the self-contact
+        barrier (``Scene.self_intersection = "barrier"``) self_contact, and total. Computed with
         the scene's gas amounts and the registry's effects: records after a
         :meth:`Simulation.set_rest_pressure` hold another amount of gas than this counts.
         """
@@ -179,10 +190,14 @@ def energy(scene: Scene, x: ArrayLike, v: ArrayLike) -> dict[str, NDArray[np.flo
     xs = np.ascontiguousarray(x.reshape(-1, x.shape[-2], 2))
     vs = np.ascontiguousarray(v.reshape(-1, x.shape[-2], 2))
     n_rings = len(scene.rings)
-    table = np.zeros((xs.shape[0], len(ENERGY_PARTS)))
+    names = ENERGY_PARTS + (("self_contact",) if model.self_barrier else ())
+    table = np.zeros((xs.shape[0], len(names)))
+    bw = build_barrier_workspace(xs.shape[1]) if model.self_barrier else None
     for k in range(xs.shape[0]):
         ring_energy(model, k % n_rings, xs[k], vs[k], table[k])
-    out = {name: table[:, j].reshape(lead) for j, name in enumerate(ENERGY_PARTS)}
+        if bw is not None:
+            table[k, -1] = self_contact_energy(model, k % n_rings, xs[k], bw)
+    out = {name: table[:, j].reshape(lead) for j, name in enumerate(names)}
     out["total"] = table.sum(axis=1).reshape(lead)
     return out
 
@@ -235,7 +250,9 @@ class Simulation:
         self.model = build_model(scene, effects)
         self.solver = build_solver(scene)
         n_rings, n_nodes = len(scene.rings), scene.rings[0].n_nodes
-        self.ws = build_workspace(n_nodes, n_rings, effects, barrier=self.model.self_barrier)
+        self.ws = build_workspace(
+            n_nodes, n_rings, effects, barrier=self.model.self_barrier, ring_pairs=self.model.collide
+        )
         self.state = empty_state(n_rings, n_nodes)
         self.trial = empty_state(n_rings, n_nodes)
         shape = (n_rings, n_nodes, 2)

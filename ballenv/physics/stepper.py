@@ -87,7 +87,7 @@ def collision_kicks(model, state, h, ws):
         return False
     collision_impulses(
         state.x, state.v, h, model.thickness, model.node_mass, model.collide,
-        model.reject_self_intersection, cw, cw.kicked, cw.kinetic_change,
+        model.reject_self_intersection, cw, cw.kicked, cw.kinetic_change, ws.ring_pairs,
     )  # fmt: skip
     created = 0.0
     for r in range(state.x.shape[0]):
@@ -103,7 +103,7 @@ def step_ring(model, solver, r, state, v0, trial, h, ws):
     copy_into(trial.active[r], state.active[r])
     its = newton_ring(
         model, solver, r, state.x[r], v0[r], state.a[r], h, trial.x[r], trial.v[r], trial.a[r], ws,
-        trial.active[r],
+        trial.active[r], ws.barrier,
     )  # fmt: skip
     if its < 0:
         return -REJECT_NEWTON
@@ -212,7 +212,7 @@ def try_step(model, solver, state, trial, h, ws):
                 impulse_ratio = min(impulse_ratio, model.impulse_bound[r] / impulse)
         if solver.rtol > 0.0:
             error = max(error, ring_error(model, solver, r, state, trial, h))
-    if model.collide and rings_intrude(trial.x, model.thickness, ws.collision):
+    if model.collide and rings_intrude(trial.x, model.thickness, ws.ring_pairs):
         return -REJECT_INTRUSION, 0.0, 0.0
     return total, impulse_ratio, error
 
@@ -342,7 +342,7 @@ def advance(model, solver, ws, state, trial, clock, counters, t_pause, t_end, ou
         if counters[COUNT_RECORDS] >= capacity or counters[COUNT_EVENTS] + 3 * n_rings > rec.events.shape[0]:
             return STATUS_BUFFER_FULL
         if model.collide:
-            limit = collision_step_limit(state.x, state.v, model.thickness, clock[CLOCK_H], ws.collision)
+            limit = collision_step_limit(state.x, state.v, model.thickness, clock[CLOCK_H], ws.ring_pairs)
             clock[CLOCK_H] = max(min(clock[CLOCK_H], limit), solver.dt_min)
         stop, at_end, at_out, at_grid = step_end(solver, clock, counters, t_end, output_dt)
         h = stop - clock[CLOCK_T]

@@ -9,7 +9,7 @@ import pytest
 
 import ballenv  # noqa: F401  (registers the env)
 from ballenv.controllers import PaddleDribble, PressurePump
-from ballenv.envs.batch import REWARD_AT_MARGIN, height_reward
+from ballenv.envs.batch import ENVS_PER_LINE, REWARD_AT_MARGIN, guided_chunks, height_reward
 from ballenv.physics.ring import total_mass
 
 MODES = ("pressure", "paddle")
@@ -130,3 +130,17 @@ def test_ending_early_never_pays(seed):
     quit, quit_steps, quit_terminated = episode(quit_at=150)
     assert quit_terminated and quit_steps < kept_steps
     assert quit < kept
+
+
+@pytest.mark.parametrize("n_envs", [1, 2, 9, 64, 257])
+@pytest.mark.parametrize("threads", [2, 3])
+def test_guided_chunks_cover_every_env_once_shrinking_and_line_aligned(n_envs, threads):
+    bounds = guided_chunks(n_envs, threads)
+    sizes = np.diff(bounds)
+    assert bounds[0] == 0 and bounds[-1] == n_envs and (sizes >= 1).all()
+    assert (np.diff(sizes) <= 0).all()  # largest first, single envs last
+    big = sizes >= ENVS_PER_LINE
+    assert (sizes[big] % ENVS_PER_LINE == 0).all()
+    assert (np.asarray(bounds[:-1])[big] % ENVS_PER_LINE == 0).all()  # big chunks start on a line
+    if n_envs >= 2 * threads:
+        assert sizes[-1] == 1

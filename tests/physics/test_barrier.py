@@ -1,10 +1,12 @@
 """The self-contact barrier: its distance derivatives and Jacobian against finite differences,
 continuous collision detection, the broad phase, and rings whose far wall parts meet."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
-from ballenv.physics import Ground, Ring, Scene, simulate
+from ballenv.physics import Ground, Ring, Scene, Simulation, simulate
 from ballenv.physics.barrier import (
     barrier_energy,
     barrier_force,
@@ -15,11 +17,13 @@ from ballenv.physics.barrier import (
     excluded,
     find_pairs,
     impact_fraction,
+    near_pairs,
     point_edge_derivatives,
     point_edge_distance2,
     point_edge_impact,
 )
 from ballenv.physics.collision import self_intersects
+from ballenv.physics.layout import ENERGY_TOTAL
 from ballenv.physics.linalg import band_to_dense
 from ballenv.physics.model import build_model, build_workspace
 from ballenv.physics.simulation import initial_state
@@ -165,6 +169,26 @@ def test_a_ring_at_rest_has_no_candidate_pairs():
     assert find_pairs(x[0], x[0], model.rest_len[0], model.thickness[0], ws.barrier) == 0
 
 
+def test_near_pairs_remembers_clear_positions_and_nothing_else():
+    scene = Scene(rings=[Ring()], gravity=0.0)
+    model = build_model(scene)
+    x, _ = initial_state(scene)
+    x = x[0].copy()
+    bw = build_workspace(x.shape[0]).barrier
+    rest_len, dhat = model.rest_len[0], model.thickness[0]
+    assert near_pairs(x, rest_len, dhat, bw) == 0
+    assert np.array_equal(bw.clear_x, x) and tuple(bw.clear_key) == (rest_len, dhat)
+    squashed = x.copy()
+    squashed[:, 1] = x[0, 1] + 0.02 * (x[:, 1] - x[0, 1])  # top and bottom within dhat
+    near = near_pairs(squashed, rest_len, dhat, bw)
+    assert near > 0 and np.array_equal(bw.clear_x, x)  # swept, and not remembered
+    assert near_pairs(x, rest_len, dhat, bw) == 0
+    # the remembered positions are what is compared: planted, they answer without a sweep
+    bw.clear_x[:] = squashed
+    assert near_pairs(squashed, rest_len, dhat, bw) == 0
+    assert near_pairs(squashed, rest_len, 1.01 * dhat, bw) == near  # but only with their dhat
+
+
 def test_pairs_near_along_the_ring_are_excluded():
     n, rest_len, dhat = 64, 1e-2, 2e-3
     assert excluded(10, 10, n, rest_len, dhat) and excluded(10, 9, n, rest_len, dhat)  # its own edges
@@ -172,6 +196,19 @@ def test_pairs_near_along_the_ring_are_excluded():
     assert excluded(10, 11, n, 1e-3, dhat)  # unless that is within the arc exclusion
     assert excluded(10, 63, n, rest_len, 0.5 * 64 * rest_len)  # within the arc exclusion
     assert not excluded(10, 40, n, rest_len, dhat)
+
+
+def _within(x, rest_len, dhat):
+    """The (node, edge) pairs of ``x`` within ``dhat`` that are not excluded, by brute force."""
+    n = x.shape[0]
+    pairs = [
+        (i, j)
+        for i in range(n)
+        for j in range(n)
+        if not excluded(i, j, n, rest_len, dhat)
+        and point_edge_distance2(*x[i], *x[j], *x[(j + 1) % n]) < dhat**2
+    ]
+    return np.array(pairs, dtype=np.int64).reshape(-1, 2)
 
 
 def _min_pair_distance(x, rest_len, dhat):
@@ -197,6 +234,22 @@ def test_a_soft_empty_ring_comes_to_rest_folded():
     mass = build_model(scene).node_mass[0] * 64
     assert kinetic[-4:].max() < 1e-5 * mass * 9.81 * 2 * ring.radius  # at rest
     assert not any(self_intersects(xk[0]) for xk in traj.x)
+    barrier = traj.energy()["self_contact"][:, 0]
+    assert barrier[0] == 0.0 and barrier[-1] > 0.0  # resting within dhat: the barrier holds it
+    pairs = _within(x, rest_len, h)
+    kappa = build_model(scene).ea[0] / rest_len
+    assert barrier[-1] == pytest.approx(barrier_energy(x, pairs, len(pairs), kappa, h), rel=1e-12)
+
+
+def test_the_energy_table_has_the_barrier_the_stepper_carries():
+    ring = Ring(pressure=None, youngs_modulus=1e5, thickness=2e-3, n_nodes=32, position=(0.0, 0.1005))
+    scene = Scene(rings=[ring], grounds=[Ground()], damping=20.0, dt=1e-3, adaptive=True)
+    sim = Simulation(scene, output_dt=0.1)
+    assert sim.advance(0.6)
+    table = sim.trajectory().energy()
+    assert table["self_contact"][-1, 0] > 0.0
+    assert table["total"][-1, 0] == pytest.approx(sim.state.energy[0, ENERGY_TOTAL], rel=1e-12)
+    assert "self_contact" not in simulate(replace(scene, self_intersection="reject"), 0.01).energy()
 
 
 @pytest.mark.parametrize("thickness", [1e-3, 2e-3])

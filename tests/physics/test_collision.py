@@ -277,14 +277,14 @@ def test_self_contact_stops_a_fold_and_conserves_momentum():
     kicked = np.zeros_like(v)
     change = np.zeros(1)
     thickness, mass = np.array([2e-3]), np.array([1e-3])
-    count = collision_impulses(x, v, 1e-3, thickness, mass, False, True, cw, kicked, change)
+    count = collision_impulses(x, v, 1e-3, thickness, mass, False, True, cw, kicked, change, None)
     assert count > 0
     np.testing.assert_allclose(kicked.sum(axis=1), v.sum(axis=1), atol=1e-12)  # momentum
     facing = [2 * n_side - 1 - k for k in moving]
     approach = kicked[0, moving, 1] - kicked[0, facing, 1]
     assert np.all(approach > -0.2)  # the fold's closing speed of 1 m/s is removed
     assert change[0] == pytest.approx(0.5 * mass[0] * ((kicked**2).sum() - (v**2).sum()), rel=1e-12)
-    off = collision_impulses(x, v, 1e-3, thickness, mass, False, False, cw, kicked, change)
+    off = collision_impulses(x, v, 1e-3, thickness, mass, False, False, cw, kicked, change, None)
     assert off == 0 and np.array_equal(kicked, v)
 
 
@@ -302,6 +302,6 @@ def test_fine_rings_wall_gets_no_self_contact_from_its_own_neighbours(n_nodes):
         v[0, :, 1] = -1.0
         kicked = np.zeros_like(v)
         count = collision_impulses(
-            state[None], v, 1e-3, thickness, mass, False, True, cw, kicked, np.zeros(1)
+            state[None], v, 1e-3, thickness, mass, False, True, cw, kicked, np.zeros(1), None
         )
         assert count == 0 and np.array_equal(kicked, v)
