@@ -118,13 +118,14 @@ def step_ring(model, solver, r, state, v0, trial, h, ws):
     free_energy(model, r, trial.x[r], trial.v[r], ws, trial.energy[r])
     kicks = model.collide or model.reject_self_intersection
     credit = ws.collision.kinetic_change[r] if kicks else 0.0
+    work = 0.0
     if model.moving_grounds:
         work = boundary_work(ws.surface_start, ws.surface, trial.active[r], ws.reaction, ws.friction, h)
         work += ws.arrival_work[0]
         ws.energy_tally[TALLY_BOUNDARY_WORK] += work
         credit += work
     trial.energy[r, ENERGY_BUDGET] = state.energy[r, ENERGY_BUDGET] + credit
-    if not within_energy_budget(model, r, state.energy[r], credit, trial, ws):
+    if not within_energy_budget(model, r, state.energy[r], credit, work, trial, ws):
         return -REJECT_ENERGY
     return its
 

