@@ -89,6 +89,28 @@ def test_two_balls_conserve_momentum_and_rebound():
     assert m["closest_centre_distance_m"] > 0.16  # no tunnelling
 
 
+def test_a_ball_on_a_vibrating_plate_bounces_regularly_then_doubles_its_period():
+    """Balanced preset (the fast one's coarse steps blur the bounce heights), started on the point
+    particle's period-1 orbit: at Gamma = 1.3 one apex height (within 5 %) and the map's impact
+    phase, at 1.5 two alternating heights; the map with the ring's own restitution puts the period
+    doubling in between."""
+    from ballenv.scenes.library import plate_impact_phase
+
+    res = scenes.run("vibrating-plate", fidelity="balanced", reduced=True)
+    m = res.metrics
+    assert m["period"] == [1, 2], m["period"]
+    assert 0.4 < m["restitution"] < 0.7
+    assert 1.3 < m["theory_period_doubling_at"] < 1.5
+    one = np.array(m["apex_heights_m"]["1.3"])
+    assert len(one) >= 15 and np.ptp(one) < 0.05 * one.mean()
+    phase = np.array(m["impact_phases_rad"]["1.3"])
+    assert np.abs(phase - plate_impact_phase(1.3, m["restitution"])).max() < 0.1  # rad
+    two = np.array(m["apex_heights_m"]["1.5"])
+    even, odd = two[::2], two[1::2]
+    assert abs(even.mean() - odd.mean()) > 0.1  # m
+    assert np.ptp(even) < 0.02 and np.ptp(odd) < 0.02
+
+
 def test_cli_writes_figure_video_numbers_and_trajectories(tmp_path, capsys):
     assert (
         main(["two-balls", "--out", str(tmp_path), "--fidelity", "fast", "--reduced", "--frames", "12"]) == 0

@@ -1,26 +1,31 @@
 """Ground half-planes: constrained nodes, reactions and Coulomb friction inside the Newton system.
 
-A ground ``g`` is the half-plane ``n_g . x >= d_g`` with unit normal ``n_g = (-sin a, cos a)`` for a
-slope angle ``a`` (rad) and ``d_g = n_g . (x_g, height)``: the surface passes through the ground's
-point ``(Ground.x, Ground.height)``.
+A ground ``g`` is the half-plane ``n_g . x >= d_g(t)`` with unit normal ``n_g = (-sin a, cos a)`` for
+a slope angle ``a`` (rad) and ``d_g(0) = n_g . (x_g, height)``: the surface passes through the
+ground's point ``(Ground.x, Ground.height)`` at t = 0 and moves with the velocity ``w_g(t)``
+(:mod:`.ground_motion`; ``d = d0``, ``w = 0`` for a fixed ground). The kernels here read the
+grounds at one time, rows ``layout.SURFACE`` (``Workspace.surface``: the step's end time t1).
 A node in contact is constrained on the surface and keeps the size of the system (Baraff & Witkin's
 filtered, mass-modified formulation written for the step's displacement): its two residual rows
 (``r_i = M inertia_i - F_i``, N) become
 
     tangential:  t . r_i + mu N_i s(v_t)   = 0     (Coulomb friction, N_i = n . r_i the reaction)
-    normal:      c_M m (n . x1_i - d)     = 0     (the node ends the step on the surface)
+    normal:      c_M m (n . x1_i - d(t1)) = 0     (the node ends the step on the surface)
 
-with ``t = (-n_y, n_x)``, ``v_t = t . v_i`` and the regularised sign ``s(v) = v / sqrt(v^2 + eps^2)``
-(``eps`` = ``Scene.friction_regularization``, m/s). The Jacobian rows are the same combinations of
-the unconstrained rows (exact, including ``dN_i/dx = n . J_i`` and ``mu N s'(v_t) dv_t/dx``), so the
-band structure and the low-rank Woodbury terms survive. A constraint whose reaction ``N_i`` pulls is
-released; a free node below a ground is constrained.
+with ``t = (-n_y, n_x)``, the slip ``v_t = t . (v_i - w)`` relative to the surface and the regularised
+sign ``s(v) = v / sqrt(v^2 + eps^2)`` (``eps`` = ``Scene.friction_regularization``, m/s). The Jacobian
+rows are the same combinations of the unconstrained rows (exact, including ``dN_i/dx = n . J_i`` and
+``mu N s'(v_t) dv_t/dx``; ``w`` does not depend on the nodes), so the band structure and the
+low-rank Woodbury terms survive. A constraint whose reaction ``N_i`` pulls is released; a free node
+below a ground is constrained; a constrained node ends the step with the surface's normal velocity
+(:func:`rest_on_grounds`).
 """
 
 import math
 from typing import TYPE_CHECKING
 
 from .jit import kernel
+from .layout import SURFACE_NORMAL_ACCELERATION, SURFACE_VELOCITY
 from .linalg import BAND_HALF_WIDTH
 
 if TYPE_CHECKING:
@@ -43,10 +48,19 @@ def deepest_ground(grounds, x, y):
     return best, best_phi
 
 
+@kernel(inline="always")
+def slip(grounds, g, ve, i, tx, ty):
+    """Node ``i``'s velocity ``ve[i]`` relative to ground ``g``'s surface along its tangent
+    ``(tx, ty)`` (m/s): ``t . (v - w)``."""
+    wx, wy = grounds[g, SURFACE_VELOCITY], grounds[g, SURFACE_VELOCITY + 1]
+    return tx * (ve[i, 0] - wx) + ty * (ve[i, 1] - wy)
+
+
 @kernel
 def constrain_residual(grounds, active, x1, ve, res, node_mass, c_mass, eps, reaction, friction):
-    """Replace the rows of active nodes (see module doc); store their normal reaction N_i (N) in
-    ``reaction`` and the friction force along t (N) in ``friction``."""
+    """Replace the rows of active nodes (see module doc; ``grounds``: rows ``layout.SURFACE`` at the
+    step's end); store their normal reaction N_i (N) in ``reaction`` and the friction force along t
+    (N) in ``friction``."""
     n = active.shape[0]
     for i in range(n):
         g = active[i]
@@ -61,7 +75,7 @@ def constrain_residual(grounds, active, x1, ve, res, node_mass, c_mass, eps, rea
         rt = tx * rx + ty * ry
         s = 0.0
         if mu > 0.0:
-            vt = tx * ve[i, 0] + ty * ve[i, 1]
+            vt = slip(grounds, g, ve, i, tx, ty)
             s = vt / math.sqrt(vt * vt + eps * eps)
         reaction[i] = rn
         friction[i] = -mu * rn * s
@@ -77,14 +91,14 @@ def constrain_residual(grounds, active, x1, ve, res, node_mass, c_mass, eps, rea
 def sliding(grounds, g, ve, i, eps):
     """Ground ``g``'s normal ``(nx, ny)``, tangent ``(tx, ty) = (-ny, nx)`` and friction ``mu``, and
     the regularised sliding direction ``s = vt / sqrt(vt^2 + eps^2)`` of node ``i``'s velocity
-    ``ve[i]`` (``vt`` along t, m/s) with its derivative ``ds/dvt`` (s/m); ``s = ds = 0`` without
-    friction."""
+    ``ve[i]`` relative to the surface (``vt`` along t, m/s: :func:`slip`) with its derivative
+    ``ds/dvt`` (s/m); ``s = ds = 0`` without friction."""
     nx, ny, mu = grounds[g, 0], grounds[g, 1], grounds[g, 3]
     tx, ty = -ny, nx
     s = 0.0
     ds = 0.0
     if mu > 0.0:
-        vt = tx * ve[i, 0] + ty * ve[i, 1]
+        vt = slip(grounds, g, ve, i, tx, ty)
         q = vt * vt + eps * eps
         s = vt / math.sqrt(q)
         ds = eps * eps / (q * math.sqrt(q))
@@ -160,22 +174,31 @@ def activate_penetrating(grounds, active, x1, only_deeper_than):
 
 @kernel
 def rest_on_grounds(grounds, active, v1, a1):
-    """A constrained node ends the step at rest in the ground's normal direction (normal velocity
-    and algorithmic acceleration zeroed): it sits on the surface. Without this, backward Euler's
-    ``v1 = (x1 - x0) / h`` leaves a node that arrived from a gap a velocity into the ground, and the
-    Newmark update of generalized-alpha reflects it and leaves an acceleration spike that the alpha_m
-    term feeds back into the next steps (the known weakness of Newmark schemes with contact)."""
+    """A constrained node ends the step at rest on the surface in the ground's normal direction: its
+    normal velocity and algorithmic acceleration become the surface's, ``n . w`` and ``a_n``
+    (``grounds``: rows ``layout.SURFACE`` at the step's end; 0 for a fixed ground). Without this,
+    backward Euler's ``v1 = (x1 - x0) / h`` leaves a node that arrived from a gap a velocity into
+    the ground, and the Newmark update of generalized-alpha reflects it and leaves an acceleration
+    spike that the alpha_m term feeds back into the next steps (the known weakness of Newmark
+    schemes with contact).
+
+    Returns ``sum_i (w_n - v_n,i) w_n`` (m^2/s^2): times the node mass, the work the surface does
+    through the impulses of this velocity change, ``m (w_n - v_n) n . w`` (0 on a fixed ground)."""
+    work = 0.0
     for i in range(active.shape[0]):
         g = active[i]
         if g == FREE:
             continue
         nx, ny = grounds[g, 0], grounds[g, 1]
-        vn = v1[i, 0] * nx + v1[i, 1] * ny
-        an = a1[i, 0] * nx + a1[i, 1] * ny
+        wn = grounds[g, SURFACE_VELOCITY] * nx + grounds[g, SURFACE_VELOCITY + 1] * ny
+        vn = v1[i, 0] * nx + v1[i, 1] * ny - wn
+        an = a1[i, 0] * nx + a1[i, 1] * ny - grounds[g, SURFACE_NORMAL_ACCELERATION]
         v1[i, 0] -= vn * nx
         v1[i, 1] -= vn * ny
         a1[i, 0] -= an * nx
         a1[i, 1] -= an * ny
+        work -= vn * wn
+    return work
 
 
 def ground_enabled(scene: "Scene") -> bool:

@@ -1,24 +1,34 @@
 """A ring's energy budget: what it may hold after a step, and the removal of a small excess.
 
-Nothing in a scene adds energy but actuation (the gas amount, paddle impulses) and the push-out of
-collision impulses: the gas and gravity are potentials; damping, friction and the ground's
-constraints only remove it. Each ring carries ``State.energy[r]`` (columns ``layout.ENERGY``): its
-energy (J), its free part (kinetic plus elastic and gas energy above its inflated circle at rest,
-``Model.rest_energy``; gravity left out) and its budget (its energy at the start plus what
-actuation and collision impulses gave it since). The energy parts come from the effects
-(:func:`assembly.ring_energy`).
+Nothing in a scene adds energy but actuation (the gas amount, paddle impulses), the push-out of
+collision impulses and moving grounds (:func:`boundary_work`): the gas and gravity are potentials;
+damping, friction and fixed grounds' constraints only remove it. Each ring carries
+``State.energy[r]`` (columns ``layout.ENERGY``): its energy (J), its free part (kinetic plus elastic
+and gas energy above its inflated circle at rest, ``Model.rest_energy``; gravity left out) and its
+budget (its energy at the start plus what actuation, collision impulses and moving grounds gave it
+since). The energy parts come from the effects (:func:`assembly.ring_energy`).
 """
 
 import math
 
 from .assembly import gravity_column, ring_energy
 from .barrier import barrier_energy, find_pairs, near_pairs, reach, stiffness
-from .contact import rest_on_grounds
+from .contact import FREE, rest_on_grounds
 from .geometry import centre_of_mass
 from .jit import kernel
-from .layout import ENERGY_BUDGET, ENERGY_FREE, ENERGY_TOTAL, TALLY_PROJECTED, TALLY_REMOVED
+from .layout import (
+    ENERGY_BUDGET,
+    ENERGY_FREE,
+    ENERGY_TOTAL,
+    SURFACE_OFFSET,
+    SURFACE_VELOCITY,
+    TALLY_BOUNDARY_WORK,
+    TALLY_PROJECTED,
+    TALLY_REMOVED,
+)
 
 ENERGY_GROWTH_TOL = 1e-2  # largest energy gain of a step, relative to the ring's free energy
+WORK_ERROR_TOL = 0.1  # largest unpayable excess of a step on a moving ground, relative to its |work|
 
 
 @kernel
@@ -33,6 +43,49 @@ def free_energy(model, r, x, v, ws, out):
         out[ENERGY_TOTAL] += self_contact_energy(model, r, x, ws.barrier)
     g = gravity_column(model)
     out[ENERGY_FREE] = out[ENERGY_TOTAL] - (parts[g] if g >= 0 else 0.0) - model.rest_energy[r]
+
+
+@kernel(inline="always")
+def _surface_displacement(start, end, g, h):
+    """Ground ``g``'s surface displacement (m) over a step of ``h`` (s):
+    ``(d(t1) - d(t0)) n + h (t . w) t``."""
+    nx, ny = end[g, 0], end[g, 1]
+    normal = end[g, SURFACE_OFFSET] - start[g, SURFACE_OFFSET]
+    slide = h * (-ny * end[g, SURFACE_VELOCITY] + nx * end[g, SURFACE_VELOCITY + 1])
+    return normal * nx - slide * ny, normal * ny + slide * nx
+
+
+@kernel
+def boundary_work(start, end, active, reaction, friction, h):
+    """Work (J) the grounds' surfaces do on a ring in a step of ``h`` (s), credited to its budget:
+
+        W = sum_i f_i . ds_g(i),      f_i = N_i n + F_i t,
+        ds = (d(t1) - d(t0)) n + h (t . w) t,
+
+    over the ring's constrained nodes ``i`` at the step's end (``active[i]`` = their ground ``g``),
+    with the normal reaction ``N_i`` (``reaction``, N), the friction force ``F_i`` along
+    ``t = (-n_y, n_x)`` (``friction``, N) and ``ds`` (m) the surface's displacement over the step,
+    ``h`` times its mean velocity (``start``, ``end``: the grounds at the step's start and end, rows
+    ``layout.SURFACE``; the tangential velocity ``t . w = t . u`` is constant). The power of the
+    contact force on a node is ``f . v = f . w + f . (v - w)``: the first term is the ground's work,
+    the second (the friction on the slip; the normal part vanishes, a constrained node moving with
+    the surface along n) only dissipates. The force is the step's end force, as in backward
+    Euler's energy balance (``sum_i f_i . (x1_i - x0_i)``; a node resting on the surface through
+    the step moves along n by exactly ``n . ds``). 0 on fixed grounds. The stepper adds the work of
+    the impulses that put arriving nodes at rest on the surface (``Workspace.arrival_work``,
+    :func:`contact.rest_on_grounds`): ``sum_i m (w_n - v_n,i) w_n`` over the velocities the step's
+    kinematics gave them."""
+    work = 0.0
+    for i in range(active.shape[0]):
+        g = active[i]
+        if g == FREE:
+            continue
+        nx, ny = end[g, 0], end[g, 1]
+        dx, dy = _surface_displacement(start, end, g, h)
+        fx = reaction[i] * nx - friction[i] * ny
+        fy = reaction[i] * ny + friction[i] * nx
+        work += fx * dx + fy * dy
+    return work
 
 
 @kernel
@@ -78,12 +131,14 @@ def _energy_scale(model, r, x, parts):
 
 
 @kernel
-def within_energy_budget(model, r, before, kick, trial, ws):
+def within_energy_budget(model, r, before, kick, work, trial, ws):
     """Hold ring ``r``'s energy after a trial step to its budget ``trial.energy[r, ENERGY_BUDGET]``
-    (J): its energy at the start of the run plus what actuation and collision impulses gave it
-    since. Nothing else in a scene adds energy: the gas and gravity are potentials; damping,
-    friction and the ground's constraints only remove it. ``before`` is the ring's carried energy
-    row before the step, ``kick`` the kinetic energy the step's collision impulses gave it.
+    (J): its energy at the start of the run plus what actuation, collision impulses and moving
+    grounds gave it since. Nothing else in a scene adds energy: the gas and gravity are potentials;
+    damping, friction and fixed grounds' constraints only remove it. ``before`` is the ring's
+    carried energy row before the step, ``kick`` the energy the step gave it from outside: the
+    kinetic energy of its collision impulses plus the moving grounds' work ``work`` (J,
+    :func:`boundary_work`).
 
     A gain of the step above ``ENERGY_GROWTH_TOL`` times the mean free energy is a spurious solution
     (far too large implicit steps of a nonlinear ring converge to some): returns False, the step is
@@ -93,11 +148,17 @@ def within_energy_budget(model, r, before, kick, trial, ws):
     the ring's velocities relative to its centre of mass, keeping its momentum
     (:func:`energy.remove_internal_kinetic_energy`), ``trial.energy[r]`` is recomputed and the
     removal is tallied in ``ws.energy_tally``; ground-constrained nodes are then put back at rest
-    in their ground's normal direction (which only lowers the energy further). If the ring's spin
-    and deformation hold too little kinetic energy to pay the excess (a ring in rigid translation),
-    an excess within round-off (1e-12 of :func:`_energy_scale`) is accepted as it is and a larger
-    one returns False. ``ws.energy`` must hold the energy parts of the trial state (as
-    :func:`free_energy` leaves them)."""
+    on their ground in its normal direction (``ws.surface``; on a moving ground, the work of that
+    velocity change is credited to the budget and tallied). If the ring's spin and deformation hold
+    too little kinetic energy to pay the excess (a ring in rigid translation), an excess within
+    round-off (1e-12 of :func:`_energy_scale`) is accepted as it is (on a moving ground, with the
+    budget raised to the energy: an excess carried on could not be paid by the ever smaller work
+    of ever smaller retried steps); so is, on a moving ground, an excess within ``WORK_ERROR_TOL``
+    of the step's ``|work|`` (the integrator's error of that work,
+    e.g. a node leaving the surface within the step: a ball riding a plate has no internal motion
+    to pay it), with the budget raised to the
+    energy and the excess tallied as boundary work; a larger one returns False. ``ws.energy`` must
+    hold the energy parts of the trial state (as :func:`free_energy` leaves them)."""
     after = trial.energy[r]
     if energy_grew(
         before[ENERGY_TOTAL] + kick, before[ENERGY_FREE] + kick, after[ENERGY_TOTAL], after[ENERGY_FREE]
@@ -107,9 +168,19 @@ def within_energy_budget(model, r, before, kick, trial, ws):
     if excess <= 0.0:
         return True
     if not remove_internal_kinetic_energy(trial.x[r], trial.v[r], model.node_mass[r], excess):
-        return excess <= 1e-12 * _energy_scale(model, r, trial.x[r], ws.energy)
-    rest_on_grounds(model.grounds, trial.active[r], trial.v[r], trial.a[r])
+        round_off = excess <= 1e-12 * _energy_scale(model, r, trial.x[r], ws.energy)
+        if round_off and not model.moving_grounds:
+            return True
+        if not round_off and excess > WORK_ERROR_TOL * abs(work):
+            return False
+        after[ENERGY_BUDGET] = after[ENERGY_TOTAL]
+        ws.energy_tally[TALLY_BOUNDARY_WORK] += excess
+        return True
+    reset = rest_on_grounds(ws.surface, trial.active[r], trial.v[r], trial.a[r])
     free_energy(model, r, trial.x[r], trial.v[r], ws, after)
+    if model.moving_grounds:  # the surface's work putting the nodes back on it
+        after[ENERGY_BUDGET] += model.node_mass[r] * reset
+        ws.energy_tally[TALLY_BOUNDARY_WORK] += model.node_mass[r] * reset
     ws.energy_tally[TALLY_PROJECTED] += 1.0
     ws.energy_tally[TALLY_REMOVED] += excess
     return True

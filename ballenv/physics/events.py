@@ -7,8 +7,9 @@ kind ``layout.EVENT_KINDS`` (0 = touchdown, 1 = liftoff, 2 = apex).
   by linear interpolation of that velocity, its height by the cubic Hermite interpolant of the
   centre-of-mass height (values and velocities at both ends), so the bounce height is exact to the
   integrator's order, not to the output sampling;
-* touchdown: the ring had no node on a ground and now has; time from the ballistic path of the first
-  node to touch (``phi0 + s h v_n = 0``);
+* touchdown: the ring had no node on a ground and now has; time from the path of the first node to
+  touch relative to the surface (``phi0 + s h (v_n - w_n) = 0``, distance ``phi0`` and velocities at
+  the step's start);
 * lift-off: the last constraint was released; time = the end of the step (steps are short in contact).
 """
 
@@ -26,6 +27,7 @@ from .layout import (
     EVENT_RING,
     EVENT_T,
     EVENT_TOUCHDOWN,
+    SURFACE_VELOCITY,
 )
 
 __all__ = ["EVENT_APEX", "EVENT_KINDS", "EVENT_LIFTOFF", "EVENT_TOUCHDOWN", "detect_events", "event_list"]
@@ -57,8 +59,9 @@ def _write(events, n_events, t, ring, kind, height):
 
 
 @kernel
-def detect_events(model, state, trial, t, h, events, n_events):
-    """Append the events of the step ``state -> trial`` over ``[t, t + h]``; return the new count."""
+def detect_events(model, surface, state, trial, t, h, events, n_events):
+    """Append the events of the step ``state -> trial`` over ``[t, t + h]``; return the new count.
+    ``surface``: the grounds at ``t`` (rows ``layout.SURFACE``)."""
     n_rings = state.x.shape[0]
     n_nodes = state.x.shape[1]
     contact = model.grounds.shape[0] > 0
@@ -78,8 +81,10 @@ def detect_events(model, state, trial, t, h, events, n_events):
                 for i in range(n_nodes):
                     if trial.active[r, i] == FREE:
                         continue
-                    g, phi0 = deepest_ground(model.grounds, state.x[r, i, 0], state.x[r, i, 1])
-                    vn = model.grounds[g, 0] * state.v[r, i, 0] + model.grounds[g, 1] * state.v[r, i, 1]
+                    g, phi0 = deepest_ground(surface, state.x[r, i, 0], state.x[r, i, 1])
+                    nx, ny = surface[g, 0], surface[g, 1]
+                    wn = surface[g, SURFACE_VELOCITY] * nx + surface[g, SURFACE_VELOCITY + 1] * ny
+                    vn = nx * state.v[r, i, 0] + ny * state.v[r, i, 1] - wn
                     if vn < 0.0:
                         s_first = min(s_first, max(0.0, phi0 / (-vn * h)))
                 s_first = min(s_first, 1.0)

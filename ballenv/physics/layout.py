@@ -89,27 +89,52 @@ CLOCK = Layout(
     "h",  # current step size (s)
     "energy_removed",  # energy removed by the energy budget so far (J)
     "collision_gain",  # energy collision impulses created so far (J)
+    "boundary_work",  # work moving grounds did on the rings so far (J)
 )
 CLOCK_T = CLOCK.index("t")
 CLOCK_H = CLOCK.index("h")
 CLOCK_ENERGY_REMOVED = CLOCK.index("energy_removed")
 CLOCK_COLLISION_GAIN = CLOCK.index("collision_gain")
+CLOCK_BOUNDARY_WORK = CLOCK.index("boundary_work")
 N_CLOCK = CLOCK.size
 
 # columns of State.energy (J): a ring's energy, its free part (kinetic plus elastic and gas energy
 # above the inflated circle at rest, gravity left out) and its energy budget (the energy at the
-# start plus what actuation and collision impulses gave it since)
+# start plus what actuation, collision impulses and moving grounds gave it since)
 ENERGY = Layout("total", "free", "budget")
 ENERGY_TOTAL = ENERGY.index("total")
 ENERGY_FREE = ENERGY.index("free")
 ENERGY_BUDGET = ENERGY.index("budget")
 
 # Workspace.energy_tally of a trial step: rings whose energy the budget lowered, the energy it
-# removed (J), the net energy the step's collision impulses created (J; 0 if they removed energy)
-TALLY = Layout("projected", "removed", "collision_gain")
+# removed (J), the net energy the step's collision impulses created (J; 0 if they removed energy),
+# the work moving grounds did on the rings (J)
+TALLY = Layout("projected", "removed", "collision_gain", "boundary_work")
 TALLY_PROJECTED = TALLY.index("projected")
 TALLY_REMOVED = TALLY.index("removed")
 TALLY_COLLISION_GAIN = TALLY.index("collision_gain")
+TALLY_BOUNDARY_WORK = TALLY.index("boundary_work")
+
+# columns of Model.grounds, a ground as described: unit normal n, offset d0 (m) at t = 0,
+# friction coefficient, constant velocity u (m/s), amplitude A (m) and angular frequency
+# omega = 2 pi f (rad/s) of its oscillation along n (ground_motion.py)
+GROUND = Layout(("normal", 2), "offset", "friction", ("velocity", 2), "amplitude", "angular_frequency")
+GROUND_NORMAL = GROUND.index("normal")
+GROUND_OFFSET = GROUND.index("offset")
+GROUND_FRICTION = GROUND.index("friction")
+GROUND_VELOCITY = GROUND.index("velocity")
+GROUND_AMPLITUDE = GROUND.index("amplitude")
+GROUND_ANGULAR_FREQUENCY = GROUND.index("angular_frequency")
+
+# columns of Workspace.surface, a ground at one time t: unit normal n, offset d(t) (m), friction
+# coefficient (the first four as in GROUND, so the contact code reads either), surface velocity
+# w(t) (m/s) and the surface's acceleration along n (m/s^2)
+SURFACE = Layout(("normal", 2), "offset", "friction", ("velocity", 2), "normal_acceleration")
+SURFACE_NORMAL = SURFACE.index("normal")
+SURFACE_OFFSET = SURFACE.index("offset")
+SURFACE_FRICTION = SURFACE.index("friction")
+SURFACE_VELOCITY = SURFACE.index("velocity")
+SURFACE_NORMAL_ACCELERATION = SURFACE.index("normal_acceleration")
 
 # rows of the event buffer: t (s), ring, kind (EVENT_KINDS), centre-of-mass height (m)
 EVENT = Layout("t", "ring", "kind", "height")

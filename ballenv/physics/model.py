@@ -25,6 +25,7 @@ from .barrier import PAIRS_PER_NODE
 from .collision import CONTACT_COLUMNS, CONTACTS_PER_NODE
 from .effects import EFFECTS
 from .effects.damping import DAMPING_CENTRE_OF_MASS, DAMPING_NONE, DAMPING_RIGID
+from .ground_motion import ground_array, grounds_move, surface_array
 from .layout import ENERGY, EVENT, TALLY
 from .linalg import BAND_COLUMNS, MAX_LOW_RANK, SOLVE_COLUMNS, zigzag_positions
 
@@ -49,7 +50,8 @@ class Model(NamedTuple):
     use_gravity: bool
     damping: float  # 1/s
     damping_mode: int
-    grounds: np.ndarray  # (G, 4): normal x, normal y, offset d (m), friction coefficient
+    grounds: np.ndarray  # (G, GROUND.size): normal, offset d0 (m), friction, motion (layout.GROUND)
+    moving_grounds: bool  # a ground moves (ground_motion.py): its work is credited to the energy budget
     contact_method: int
     friction_regularization: float  # m/s
     impulse_bound: np.ndarray  # (R,) N s: the adaptive step's largest contact impulse per step
@@ -127,6 +129,9 @@ class Workspace(NamedTuple):
     friction: np.ndarray  # (N,) friction force along the ground's tangent (N)
     energy: np.ndarray  # (P,) energy parts (J), columns assembly.energy_parts of the model's effects
     energy_tally: np.ndarray  # (TALLY.size,) what the last trial step's energy budget saw (layout.TALLY)
+    surface_start: np.ndarray  # (G, SURFACE.size) the grounds at the trial step's start (layout.SURFACE)
+    surface: np.ndarray  # (G, SURFACE.size) the grounds at the trial step's end, where contact acts
+    arrival_work: np.ndarray  # (1,) J: work of the last solve's velocity reset on moving grounds
     collision: CollisionWorkspace
     barrier: BarrierWorkspace | None  # None: the model has no self-contact barrier
     ring_pairs: CollisionWorkspace | None  # ``collision`` again where rings collide, else None
@@ -186,6 +191,7 @@ def build_model(scene, effects=EFFECTS):
         damping=float(scene.damping),
         damping_mode=mode,
         grounds=ground_array(scene.grounds),
+        moving_grounds=grounds_move(scene),
         contact_method=(
             CONTACT_NONE
             if not scene.grounds
@@ -238,23 +244,14 @@ def effect_parameters(scene, effects=EFFECTS):
     return table
 
 
-def ground_array(grounds):
-    """(G, 4) rows ``(n_x, n_y, d, mu)``: half-plane ``n . x >= d``, ``n = (-sin a, cos a)``,
-    ``d = n . (x_g, height)`` (the surface passes through the ground's point (x, height))."""
-    out = np.zeros((len(grounds), 4))
-    for k, g in enumerate(grounds):
-        nx, ny = -math.sin(g.angle), math.cos(g.angle)
-        out[k] = (nx, ny, nx * g.x + ny * g.height, g.friction)
-    return out
-
-
-def build_workspace(n_nodes, n_rings=1, effects=EFFECTS, barrier=True, ring_pairs=True):
+def build_workspace(n_nodes, n_rings=1, effects=EFFECTS, barrier=True, ring_pairs=True, n_grounds=1):
     """Scratch arrays for one ring's Newton solve and the scene's collision detection, allocated
     once per simulation (``effects``: the model's, for the size of the energy table). ``barrier``:
     the self-contact barrier's scratch, or None in its place for a model without it; ``ring_pairs``:
     the collision scratch once more as ``Workspace.ring_pairs`` (the ring-ring code's), or None
     for a model whose rings cannot collide. A step compiled with None in either place holds none of
-    that code (numba prunes ``if ... is None`` on an argument before typing)."""
+    that code (numba prunes ``if ... is None`` on an argument before typing). ``n_grounds``: at
+    least the model's number of grounds, for the rows of the grounds at the step's times."""
     n2 = 2 * n_nodes
     collision = build_collision_workspace(n_rings, n_nodes)
     return Workspace(
@@ -275,6 +272,9 @@ def build_workspace(n_nodes, n_rings=1, effects=EFFECTS, barrier=True, ring_pair
         friction=np.zeros(n_nodes),
         energy=np.zeros(len(energy_parts(effects))),
         energy_tally=np.zeros(TALLY.size),
+        surface_start=surface_array(n_grounds),
+        surface=surface_array(n_grounds),
+        arrival_work=np.zeros(1),
         collision=collision,
         barrier=build_barrier_workspace(n_nodes) if barrier else None,
         ring_pairs=collision if ring_pairs else None,

@@ -3,9 +3,10 @@
 The integrator (:mod:`.integrator`) turns the step's displacement ``dx`` into ``x1, v1, a1``; the
 residual ``r(dx) = M ((1 - alpha_m) a1 + alpha_m a0) - F`` sums the effects' forces
 (:func:`assembly.ring_force`), with the rows of ground-constrained nodes replaced
-(:mod:`.contact`). Its exact Jacobian ``c_M M - c_x dF/dx - c_v dF/dv`` is a band plus low-rank
-columns, solved in O(N) (:func:`linalg.solve_band_low_rank`). The iteration stops when the residual
-is small against the forces it balances, ``|r|_inf <= newton_tol * max_i (|M inertia_i| + |F_i|)``,
+(:mod:`.contact`, on the grounds at the step's end, ``Workspace.surface``, which the stepper
+fills). Its exact Jacobian ``c_M M - c_x dF/dx - c_v dF/dv`` is a band plus low-rank columns,
+solved in O(N) (:func:`linalg.solve_band_low_rank`). The iteration stops when the residual is small
+against the forces it balances, ``|r|_inf <= newton_tol * max_i (|M inertia_i| + |F_i|)``,
 or when a correction is at round-off level (``|dx|_inf <= 1e-13 |x|_inf``); it fails (the step is
 rejected) on a non-finite value, a singular system, or after ``newton_max_iter`` corrections. (A
 tolerance on positions alone would not do: an error ``dx`` in ``x1`` is an error ``dx / h`` in
@@ -79,7 +80,7 @@ def residual(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active):
         return math.inf, 0.0, scale, False
     if model.contact_method != CONTACT_NONE:
         constrain_residual(
-            model.grounds, active, x1, ws.ve, res, m, c_mass, model.friction_regularization,
+            ws.surface, active, x1, ws.ve, res, m, c_mass, model.friction_regularization,
             ws.reaction, ws.friction,
         )  # fmt: skip
     merit = 0.0
@@ -104,7 +105,7 @@ def correction(model, solver, r, x0, h, ws, active):
         wide = add_barrier_jacobian(model, r, c_x, ws, rank, ws.barrier)
     if model.contact_method != CONTACT_NONE:
         constrain_jacobian(
-            model.grounds, active, ws.ve, ws.reaction, ws.band, ws.pos, ws.u, rank, m, c_mass,
+            ws.surface, active, ws.ve, ws.reaction, ws.band, ws.pos, ws.u, rank, m, c_mass,
             c_v, model.friction_regularization,
         )  # fmt: skip
         if wide > rank:
@@ -162,7 +163,7 @@ def constrain_barrier_rows(model, active, ws, rank, wide, bw):
     """The ground constraints on the barrier's low-rank columns ``rank ... wide - 1``."""
     if bw is None:
         return
-    constrain_low_rank_rows(model.grounds, active, ws.ve, bw.u, rank, wide, model.friction_regularization)
+    constrain_low_rank_rows(ws.surface, active, ws.ve, bw.u, rank, wide, model.friction_regularization)
 
 
 @kernel
@@ -243,15 +244,16 @@ def barrier_start(model, solver, r, x0, h, ws, bw):
 
 
 @kernel(inline="always")
-def update_contact_set(model, active, x1, reaction):
+def update_contact_set(surface, active, x1, reaction):
     """After convergence: free the constrained nodes whose normal reaction ``reaction`` (N) pulls,
-    then constrain free nodes below a ground. Returns True if the set changed."""
+    then constrain free nodes below a ground (``surface``: the grounds at the step's end). Returns
+    True if the set changed."""
     changed = False
     for i in range(active.shape[0]):
         if active[i] != FREE and reaction[i] < 0.0:
             active[i] = FREE
             changed = True
-    if activate_penetrating(model.grounds, active, x1, PENETRATION_TOLERANCE):
+    if activate_penetrating(surface, active, x1, PENETRATION_TOLERANCE):
         changed = True
     return changed
 
@@ -314,8 +316,9 @@ def newton_iterate(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active):
 
     The set is never changed from an unconverged iterate: far from the solution an iterate may swing
     nodes through a ground they never reach. ``ws.reaction``/``ws.friction`` receive the ground
-    reactions. Returns the number of Newton corrections (>= 0), or ``FAILED`` (the step must be
-    rejected).
+    reactions, ``ws.arrival_work[0]`` the work (J) a moving surface did by putting the constrained
+    nodes at rest on it (:func:`contact.rest_on_grounds`). Returns the number of Newton corrections
+    (>= 0), or ``FAILED`` (the step must be rejected).
     """
     contact = model.contact_method != CONTACT_NONE
     inner_updates = model.contact_method == CONTACT_MASS_MODIFICATION
@@ -325,7 +328,7 @@ def newton_iterate(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active):
         return FAILED
     if contact and inner_updates:
         kinematics(solver, x0, v0, a0, h, x1, v1, a1, ws)
-        if activate_penetrating(model.grounds, active, x1, PENETRATION_TOLERANCE):
+        if activate_penetrating(ws.surface, active, x1, PENETRATION_TOLERANCE):
             set_changes += 1
     total = 0
     settled = False
@@ -344,8 +347,9 @@ def newton_iterate(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active):
         if settled or worst <= solver.newton_tol * scale:
             if not contact:
                 return total
-            if not update_contact_set(model, active, x1, ws.reaction):
-                rest_on_grounds(model.grounds, active, v1, a1)
+            if not update_contact_set(ws.surface, active, x1, ws.reaction):
+                arrival = rest_on_grounds(ws.surface, active, v1, a1)
+                ws.arrival_work[0] = model.node_mass[r] * arrival
                 return total
             set_changes += 1
             if set_changes > MAX_CONTACT_SET_CHANGES:

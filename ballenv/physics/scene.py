@@ -183,21 +183,34 @@ class Ring:
 
 @dataclass(frozen=True)
 class Ground:
-    """A ground half-plane: flat (angle 0), sloped, a wall or a ceiling.
+    """A ground half-plane: flat (angle 0), sloped, a wall or a ceiling; fixed, or moving rigidly.
+
+    The surface moves with a constant ``velocity`` u plus an oscillation along its normal n, so
+    that its offset along n is ``d(t) = d0 + n . u t + A sin(2 pi f t)`` and its velocity
+    ``w(t) = u + A 2 pi f cos(2 pi f t) n`` (``ballenv.physics.ground_motion``). A node in contact
+    ends each step on the surface with the surface's normal velocity; Coulomb friction acts on its
+    velocity relative to the surface.
 
     Attributes:
         angle: angle a (rad) of the surface in [-pi, pi]; the normal into the free side is
             (-sin a, cos a): 0 is a floor, positive angles rise to the right, pi/2 a wall with the
             free side to its left (a right wall), -pi/2 a left wall, pi a ceiling.
-        height: y (m) of a point of the surface.
+        height: y (m) of a point of the surface at t = 0.
         friction: Coulomb coefficient mu in [0, 10] (0: frictionless).
-        x: x (m) of that point (default 0): the surface passes through (x, height).
+        x: x (m) of that point (default 0): the surface passes through (x, height) at t = 0.
+        velocity: constant velocity u (m/s) of the surface, each component in [-1000, 1000]: along
+            the surface a conveyor belt, along its normal a rising or sinking plate.
+        amplitude: amplitude A (m) of the oscillation along the normal, in [0, 100]; 0: none.
+        frequency: its frequency f (Hz), in [0, 1e5]; above 0 when ``amplitude`` is.
     """
 
     angle: float = 0.0
     height: float = 0.0
     friction: float = 0.0
     x: float = 0.0
+    velocity: tuple[float, float] = (0.0, 0.0)
+    amplitude: float = 0.0
+    frequency: float = 0.0
 
     def __post_init__(self) -> None:
         o = "Ground"
@@ -206,6 +219,16 @@ class Ground:
         s(self, "height", check_real(o, "height", self.height, -1e6, 1e6, "m"))
         s(self, "x", check_real(o, "x", self.x, -1e6, 1e6, "m"))
         s(self, "friction", check_real(o, "friction", self.friction, 0.0, 10.0))
+        s(self, "velocity", check_vector(o, "velocity", self.velocity, 1e3, "m/s"))
+        s(self, "amplitude", check_real(o, "amplitude", self.amplitude, 0.0, 100.0, "m"))
+        oscillates = self.amplitude > 0.0
+        unit = "Hz (above 0 when amplitude > 0)" if oscillates else "Hz"
+        s(self, "frequency", check_real(o, "frequency", self.frequency, 0.0, 1e5, unit, low_open=oscillates))
+
+    @property
+    def moves(self) -> bool:
+        """The surface moves: a velocity or an oscillation."""
+        return self.velocity != (0.0, 0.0) or self.amplitude > 0.0
 
 
 @dataclass(frozen=True)

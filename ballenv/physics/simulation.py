@@ -32,6 +32,7 @@ from .events import event_list
 from .geometry import polygon_area
 from .integrator import build_solver
 from .layout import (
+    CLOCK_BOUNDARY_WORK,
     CLOCK_COLLISION_GAIN,
     CLOCK_ENERGY_REMOVED,
     CLOCK_H,
@@ -103,8 +104,10 @@ class SimulationStats:
     ring's velocities relative to its centre of mass; ``energy_removed`` (J): the sum of those
     excesses (``energy.within_energy_budget``); ``collision_gain`` (J): the energy ring-ring and
     self-contact impulses created by pushing out nodes that started a step inside the contact
-    distance, summed over the steps where their net effect was a gain (the one source of energy
-    besides actuation)."""
+    distance, summed over the steps where their net effect was a gain (a source of energy besides
+    actuation); ``boundary_work`` (J): the work moving grounds did on the rings,
+    ``sum_steps h sum_i f_i . w`` (``energy.boundary_work``; 0 with fixed grounds), which their
+    energy budgets are credited with."""
 
     steps: int
     rejected_steps: int
@@ -116,6 +119,7 @@ class SimulationStats:
     energy_projected: int = 0
     energy_removed: float = 0.0
     collision_gain: float = 0.0
+    boundary_work: float = 0.0
 
 
 @dataclass
@@ -251,7 +255,12 @@ class Simulation:
         self.solver = build_solver(scene)
         n_rings, n_nodes = len(scene.rings), scene.rings[0].n_nodes
         self.ws = build_workspace(
-            n_nodes, n_rings, effects, barrier=self.model.self_barrier, ring_pairs=self.model.collide
+            n_nodes,
+            n_rings,
+            effects,
+            barrier=self.model.self_barrier,
+            ring_pairs=self.model.collide,
+            n_grounds=len(scene.grounds),
         )
         self.state = empty_state(n_rings, n_nodes)
         self.trial = empty_state(n_rings, n_nodes)
@@ -407,6 +416,7 @@ class Simulation:
             energy_projected=int(c[COUNT_ENERGY_PROJECTED]),
             energy_removed=float(clock[CLOCK_ENERGY_REMOVED]),
             collision_gain=float(clock[CLOCK_COLLISION_GAIN]),
+            boundary_work=float(clock[CLOCK_BOUNDARY_WORK]),
         )
 
     def trajectory(self) -> Trajectory:
@@ -491,7 +501,7 @@ def _grown(rec: Recording, counters: NDArray[np.int64]) -> Recording:
 
 
 def _check_above_grounds(caller: str, grounds: NDArray[np.float64], x: NDArray[np.float64]) -> None:
-    for g, (nx, ny, d, _) in enumerate(grounds):
+    for g, (nx, ny, d) in enumerate(grounds[:, :3]):  # d = d(0)
         phi = x[..., 0] * nx + x[..., 1] * ny - d
         if np.any(phi < 0.0):
             ring, node = np.argwhere(phi < 0.0)[0]

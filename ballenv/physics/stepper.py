@@ -14,11 +14,13 @@ from .assembly import ring_force
 from .collision import collision_impulses, collision_step_limit, rings_intrude, self_intersects
 from .contact import FREE
 from .effects.gas import ring_pressure
-from .energy import free_energy, within_energy_budget
+from .energy import boundary_work, free_energy, within_energy_budget
 from .events import detect_events
+from .ground_motion import ground_surfaces
 from .integrator import arrival_factor, carries_acceleration
 from .jit import copy_into, kernel
 from .layout import (
+    CLOCK_BOUNDARY_WORK,
     CLOCK_COLLISION_GAIN,
     CLOCK_ENERGY_REMOVED,
     CLOCK_H,
@@ -44,6 +46,8 @@ from .layout import (
     STATUS_DONE,
     STATUS_IMPULSE_AT_DT_MIN,
     STATUS_STEP_TOO_SMALL,
+    SURFACE_VELOCITY,
+    TALLY_BOUNDARY_WORK,
     TALLY_COLLISION_GAIN,
     TALLY_PROJECTED,
     TALLY_REMOVED,
@@ -99,7 +103,9 @@ def collision_kicks(model, state, h, ws):
 @kernel(inline="always")
 def step_ring(model, solver, r, state, v0, trial, h, ws):
     """Ring ``r``'s trial step and its own acceptance tests: returns its Newton corrections, or
-    minus the ``REJECT_`` code (Newton failed, the wall crossed itself, the energy budget)."""
+    minus the ``REJECT_`` code (Newton failed, the wall crossed itself, the energy budget). The
+    energy the step's collision impulses and moving grounds gave the ring
+    (:func:`energy.boundary_work`, tallied) is credited to its energy budget and guard."""
     copy_into(trial.active[r], state.active[r])
     its = newton_ring(
         model, solver, r, state.x[r], v0[r], state.a[r], h, trial.x[r], trial.v[r], trial.a[r], ws,
@@ -111,9 +117,15 @@ def step_ring(model, solver, r, state, v0, trial, h, ws):
         return -REJECT_SELF_INTERSECTION
     free_energy(model, r, trial.x[r], trial.v[r], ws, trial.energy[r])
     kicks = model.collide or model.reject_self_intersection
-    kick = ws.collision.kinetic_change[r] if kicks else 0.0
-    trial.energy[r, ENERGY_BUDGET] = state.energy[r, ENERGY_BUDGET] + kick
-    if not within_energy_budget(model, r, state.energy[r], kick, trial, ws):
+    credit = ws.collision.kinetic_change[r] if kicks else 0.0
+    work = 0.0
+    if model.moving_grounds:
+        work = boundary_work(ws.surface_start, ws.surface, trial.active[r], ws.reaction, ws.friction, h)
+        work += ws.arrival_work[0]
+        ws.energy_tally[TALLY_BOUNDARY_WORK] += work
+        credit += work
+    trial.energy[r, ENERGY_BUDGET] = state.energy[r, ENERGY_BUDGET] + credit
+    if not within_energy_budget(model, r, state.energy[r], credit, work, trial, ws):
         return -REJECT_ENERGY
     return its
 
@@ -140,9 +152,12 @@ def contact_impulse(model, solver, r, state, v0, trial, h, ws):
         jx += h * fx
         jy += h * fy
         # the reaction that stops the node's start velocity into the surface (an arriving node, or
-        # a resting one pushed by a collision impulse): kappa m (v_n + gap / h)
-        gap = max(0.0, nx * state.x[r, i, 0] + ny * state.x[r, i, 1] - model.grounds[g, 2])
-        vn = min(0.0, v0[r, i, 0] * nx + v0[r, i, 1] * ny + gap / h)
+        # a resting one pushed by a collision impulse): kappa m (v_n - w_n + gap / h), relative to
+        # the surface at the step's start
+        start = ws.surface_start
+        gap = max(0.0, nx * state.x[r, i, 0] + ny * state.x[r, i, 1] - start[g, 2])
+        wn = start[g, SURFACE_VELOCITY] * nx + start[g, SURFACE_VELOCITY + 1] * ny
+        vn = min(0.0, v0[r, i, 0] * nx + v0[r, i, 1] * ny - wn + gap / h)
         if vn < 0.0:
             jx += m * vn * nx
             jy += m * vn * ny
@@ -161,8 +176,9 @@ def ring_error(model, solver, r, state, trial, h):
 
 
 @kernel(inline="always")
-def try_step(model, solver, state, trial, h, ws):
-    """One step of every ring from ``state`` into ``trial``.
+def try_step(model, solver, state, trial, t, h, ws):
+    """One step of every ring from ``state`` at time ``t`` (s) into ``trial`` at ``t + h``; the
+    grounds at both times go to ``ws.surface_start`` and ``ws.surface`` (:mod:`.ground_motion`).
 
     Returns (Newton corrections, impulse ratio, local error): the impulse ratio is the smallest over
     rings of ``model.impulse_bound`` over the ring's contact impulse (N s; inf without contact), the
@@ -174,18 +190,18 @@ def try_step(model, solver, state, trial, h, ws):
     (``model.collide``).
 
     A ring's contact impulse is
-    ``|h sum_i f_i + kappa sum_i m min(0, v_n,i + gap_i / h) n|``: the ring's total ground reaction
-    impulse over the step (its momentum change by contact, the paper's ``f dt``) less the reaction
-    that stops the constrained nodes' start velocity into their ground (normal velocity ``v_n < 0``
-    and distance ``gap`` at the step's start: nodes arriving in this step, and resting nodes that a
-    collision impulse pushed into the ground). Such a node loses its normal momentum in whatever
-    step it happens (a point mass hitting a rigid wall), so no step size could bring that part under
-    a tolerance; the remainder grows with ``h`` and is what the step-size control bounds. The same
-    holds for the Coulomb friction on such a node while it is stopped, at most ``mu`` times that
-    normal impulse: its tangential impulse is counted only above ``mu kappa m |v_n + gap / h|``
-    (without this, a sliding impact left a floor ``mu m v_n`` per arriving node that no step size
-    could bring under its bound). ``kappa`` is
-    the integrator's reaction to an arrival per unit momentum: 1 for backward Euler,
+    ``|h sum_i f_i + kappa sum_i m min(0, v_n,i - w_n + gap_i / h) n|``: the ring's total ground
+    reaction impulse over the step (its momentum change by contact, the paper's ``f dt``) less the
+    reaction that stops the constrained nodes' start velocity into their ground (normal velocity
+    ``v_n < 0`` relative to the surface's ``w_n`` and distance ``gap`` at the step's start: nodes
+    arriving in this step, and resting nodes that a collision impulse pushed into the ground). Such
+    a node loses its normal momentum in whatever step it happens (a point mass hitting a rigid
+    wall), so no step size could bring that part under a tolerance; the remainder grows with ``h``
+    and is what the step-size control bounds. The same holds for the Coulomb friction on such a node
+    while it is stopped, at most ``mu`` times that normal impulse: its tangential impulse is counted
+    only above ``mu kappa m |v_n - w_n + gap / h|`` (without this, a sliding impact left a floor
+    ``mu m v_n`` per arriving node that no step size could bring under its bound). ``kappa`` is the
+    integrator's reaction to an arrival per unit momentum: 1 for backward Euler,
     ``(1 - alpha_m) / beta`` for generalized-alpha (whose Newmark update reflects the node's normal
     velocity before :func:`contact.rest_on_grounds` removes it).
 
@@ -200,6 +216,8 @@ def try_step(model, solver, state, trial, h, ws):
     impulse_ratio = math.inf
     error = 0.0
     ws.energy_tally[:] = 0.0
+    ground_surfaces(model.grounds, t, ws.surface_start)
+    ground_surfaces(model.grounds, t + h, ws.surface)
     v0 = ws.collision.kicked if collision_kicks(model, state, h, ws) else state.v
     for r in range(state.x.shape[0]):
         its = step_ring(model, solver, r, state, v0, trial, h, ws)
@@ -300,8 +318,9 @@ def accept(model, solver, ws, state, trial, clock, counters, h, stop, at_grid, r
     counters[COUNT_ENERGY_PROJECTED] += int(ws.energy_tally[TALLY_PROJECTED])
     clock[CLOCK_ENERGY_REMOVED] += ws.energy_tally[TALLY_REMOVED]
     clock[CLOCK_COLLISION_GAIN] += ws.energy_tally[TALLY_COLLISION_GAIN]
+    clock[CLOCK_BOUNDARY_WORK] += ws.energy_tally[TALLY_BOUNDARY_WORK]
     counters[COUNT_EVENTS] = detect_events(
-        model, state, trial, clock[CLOCK_T], h, rec.events, counters[COUNT_EVENTS]
+        model, ws.surface_start, state, trial, clock[CLOCK_T], h, rec.events, counters[COUNT_EVENTS]
     )
     copy_state(state, trial)
     clock[CLOCK_T] = stop
@@ -346,7 +365,7 @@ def advance(model, solver, ws, state, trial, clock, counters, t_pause, t_end, ou
             clock[CLOCK_H] = max(min(clock[CLOCK_H], limit), solver.dt_min)
         stop, at_end, at_out, at_grid = step_end(solver, clock, counters, t_end, output_dt)
         h = stop - clock[CLOCK_T]
-        its, impulse_ratio, error = try_step(model, solver, state, trial, h, ws)
+        its, impulse_ratio, error = try_step(model, solver, state, trial, clock[CLOCK_T], h, ws)
         error_factor = math.inf if error == 0.0 else error ** -error_exponent(solver)
         ratio = min(impulse_ratio, error_factor)
         status = step_outcome(solver, clock, counters, h, its, ratio, error_factor < impulse_ratio)

@@ -13,6 +13,7 @@ rolling             fig. 8     unpressurised rings rolling down a slope, E = 2, 
 variable-inflation  -          gas pumped in at each apex against the same ball left alone
 slope-spin          -          a bounce on a slope with back-spin, none and top-spin
 two-balls           -          two balls colliding in flight (oblique, no gravity)
+vibrating-plate     -          a ball on a vibrating plate: bifurcation diagram against Gamma
 ==================  =========  =================================================================
 
 ``run(name, fidelity="balanced", reduced=False)`` returns a :class:`SceneResult` (parameters,
@@ -51,6 +52,8 @@ SCENES = {
         SceneInfo("slope-spin", "-", "a bounce on a 0.3 rad slope with back-spin, none, top-spin",
                   library.slope_spin),
         SceneInfo("two-balls", "-", "two balls colliding in flight", library.two_balls),
+        SceneInfo("vibrating-plate", "-", "a ball on a vibrating plate: apex heights against Gamma",
+                  library.vibrating_plate),
     )
 }  # fmt: skip
 

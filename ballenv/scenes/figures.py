@@ -208,6 +208,42 @@ def _two_balls(plt, res):
     return fig
 
 
+def _vibrating_plate(plt, res):
+    m = res.metrics
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4.5))
+    for gamma in m["gamma"]:
+        h = np.array(m["apex_heights_m"][str(gamma)]) * 1e3
+        phi = np.array(m["impact_phases_rad"][str(gamma)])
+        axes[0].plot(np.full(len(h), gamma), h, ".", ms=3, color="k")
+        axes[1].plot(np.full(len(phi), gamma), phi, ".", ms=3, color="k")
+    e = m["restitution"]
+    for ax in axes:
+        ax.axvline(m["theory_period_doubling_at"], color="tab:red", lw=1, ls="--",
+                   label=f"point particle, e = {e:.2f}: period doubling")  # fmt: skip
+        if m["measured_period_doubling_at"] is not None:
+            ax.axvline(
+                m["measured_period_doubling_at"],
+                color="tab:blue",
+                lw=1,
+                ls=":",
+                label="ring: first non-period-1",
+            )
+        ax.set_xlabel("plate acceleration Gamma = A (2 pi f)^2 / g")
+    gam = np.linspace(1.0, max(m["gamma"]), 200)
+    phase = np.arccos(np.minimum(1.0, m["theory_period_one_from"] / gam))
+    stable = gam <= m["theory_period_doubling_at"]
+    axes[1].plot(
+        gam[stable], phase[stable], color="tab:red", lw=1, label="point particle: period-1 impact phase"
+    )
+    axes[0].set_ylabel("apex of the centre above touching (mm)")
+    axes[0].set_title(f"apex heights of the last 30 bounces, f = {res.parameters['frequency']:g} Hz")
+    axes[1].set_ylabel("impact phase 2 pi f t mod 2 pi (rad)")
+    axes[1].set_title("impact phases")
+    axes[0].legend(fontsize=8)
+    axes[1].legend(fontsize=8)
+    return fig
+
+
 PLOTS = {
     "bounce-vs-pressure": _bounce_vs_pressure,
     "bounce-strip": _bounce_strip,
@@ -216,4 +252,5 @@ PLOTS = {
     "variable-inflation": _variable_inflation,
     "slope-spin": _slope_spin,
     "two-balls": _two_balls,
+    "vibrating-plate": _vibrating_plate,
 }

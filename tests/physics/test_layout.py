@@ -34,6 +34,8 @@ def test_counter_and_clock_constants_name_every_slot_once_and_fit():
         ("ENERGY_", layout.ENERGY, layout.ENERGY.size),
         ("TALLY_", layout.TALLY, layout.TALLY.size),
         ("STATUS_", layout.STATUS, layout.STATUS.size),
+        ("GROUND_", layout.GROUND, layout.GROUND.size),
+        ("SURFACE_", layout.SURFACE, layout.SURFACE.size),
     ):
         values = _constants(prefix)
         assert all(0 <= v < size for v in values.values()), (prefix, values)

@@ -97,7 +97,7 @@ def audit_trajectory(traj, t_end, error=""):
         and np.all(np.isfinite(traj.contact_force))
     )
     penetration = 0.0
-    for nx, ny, d, _ in ground_array(scene.grounds):
+    for nx, ny, d, _ in ground_array(scene.grounds)[:, :4]:  # normal, offset at t = 0, friction
         depth = d - (traj.x[..., 0] * nx + traj.x[..., 1] * ny)
         penetration = max(penetration, float(depth.max()))
     intrusion = 0.0

@@ -98,7 +98,7 @@ def test_a_failed_newton_iteration_is_rejected_and_leaves_the_state_untouched():
     state.v[:] = v0
     initial_state_values(model, solver, state, ws)
     before = [a.copy() for a in state]
-    its, impulse_ratio, error = try_step(model, solver, state, trial, 5e-3, ws)
+    its, impulse_ratio, error = try_step(model, solver, state, trial, 0.0, 5e-3, ws)
     assert its == -REJECT_NEWTON and impulse_ratio == 0.0 and error == 0.0
     for old, new in zip(before, state, strict=True):
         np.testing.assert_array_equal(old, new)
@@ -118,7 +118,7 @@ def test_every_accepted_step_is_a_converged_step():
         state.x[:] = traj.x[k]
         state.v[:] = traj.v[k]
         initial_state_values(model, solver, state, ws)
-        its, _, _ = try_step(model, solver, state, trial, traj.t[k + 1] - traj.t[k], ws)
+        its, _, _ = try_step(model, solver, state, trial, traj.t[k], traj.t[k + 1] - traj.t[k], ws)
         assert its >= 0
         scale = np.abs(traj.x[k + 1]).max()
         np.testing.assert_allclose(trial.x, traj.x[k + 1], rtol=0, atol=1e-9 * scale)
