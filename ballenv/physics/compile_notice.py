@@ -22,7 +22,7 @@ from numba.core import event
 
 LOGGER = logging.getLogger(__name__)
 NOTICE = (
-    "compiling the simulator with numba (%s); once per install, about a minute on two cores; "
+    "compiling the simulator with numba (%s); once per install, about half a minute; "
     "later runs load it from the cache"
 )
 
