@@ -1,4 +1,4 @@
-"""Many bouncing balls advanced in one compiled call: the physics behind InflatedBall-v1.
+"""Many bouncing balls advanced in one compiled call: the physics behind InflatedBall-v2.
 
 Every env holds one ring above one flat ground; the rings share material and numerical settings
 and differ in state, gas and target. One :class:`Model` with per-ring arrays of length E holds all
@@ -6,8 +6,9 @@ envs; env ``e`` is advanced by the same ``stepper.advance`` as ``simulate()``, o
 slices, with its own clock and step size. A batch of E envs therefore gives the same numbers as E
 batches of one (the single env is a batch of one).
 
-A control step of env ``e``: apply the action (set the gas, or let the paddle strike), advance to
-``(k + 1) * control_dt``, and tally the apex events of the interval. Only an apex in flight counts
+A control step of env ``e``: start the action (a gas ramp to the new setpoint, or a paddle strike
+spread over its duration: ``physics/drive.py``), advance to ``(k + 1) * control_dt`` (the steps
+deliver it), and tally the apex events of the interval. Only an apex in flight counts
 (after a lift-off, before the next touchdown): the centre of mass also turns round inside a squash.
 """
 
@@ -20,7 +21,15 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..physics.actuation import apply_impulse, rest_circle_radius, restart, set_gas, set_rest_pressure
+from ..physics.actuation import (
+    hold_gas,
+    ramp_rest_pressure,
+    rest_circle_radius,
+    restart,
+    set_gas,
+    spread_impulse,
+    stop_push,
+)
 from ..physics.contact import FREE
 from ..physics.effects.gas import ring_pressure
 from ..physics.geometry import centre_of_mass
@@ -28,6 +37,7 @@ from ..physics.integrator import build_solver
 from ..physics.jit import kernel
 from ..physics.layout import (
     CLOCK_H,
+    CLOCK_T,
     COUNT_EVENTS,
     COUNT_RECORDS,
     ENERGY_BUDGET,
@@ -50,6 +60,7 @@ from ..physics.model import (
     Model,
     Recording,
     Workspace,
+    build_drive,
     build_model,
     build_workspace,
     empty_state,
@@ -108,6 +119,7 @@ class Task(NamedTuple):
     paddle_max_impulse: float  # N s, for action +1 (-1: no strike)
     paddle_reach: float  # m: the paddle strikes when the ball's top is within this of its height
     paddle_depth: float  # m: it touches the nodes within this of the ball's top
+    paddle_strike_duration: float  # s: a strike delivers its impulse at a constant rate over this
     ground_height: float  # m
     gravity: float  # m/s^2
     reward_margin: float  # relative apex error at which the reward has fallen to REWARD_AT_MARGIN
@@ -187,6 +199,8 @@ def reset_env(
         se.contact_force[0, i, 1] = 0.0
     if model.pressurised[e]:
         set_gas(me, 0, pressure, n, ws)  # restart() counts the energy
+    hold_gas(me.drive, 0, me.gas_constant[0], pressure)  # no ramp or strike under way
+    stop_push(me.drive, 0)
     restart(me, 0, x, v, se.a[0], se.active[0], se.energy[0], ws)
     se.energy[0, ENERGY_BUDGET] = se.energy[0, ENERGY_TOTAL]  # a new episode starts a new budget
     clocks[e, :] = 0.0
@@ -247,7 +261,12 @@ def _paddle_ready(task, e, x, v):
 
 
 @kernel(inline="always")
-def _actuate(me, se, task, e, action, ws, nodes):
+def _actuate(me, se, task, e, action, t, ws, nodes):
+    """Start env ``e``'s actuation of the control step from ``t`` (s), spread over time
+    (``physics/drive.py``; the stepper delivers it step by step): in pressure mode the gas ramp from
+    the amount held to the setpoint moved toward the command, reached at the control step's end; in
+    paddle mode a strike spread over ``paddle_strike_duration`` on the nodes within
+    ``paddle_depth`` of the top now."""
     x = se.x[0]
     n = x.shape[0]
     task.impulse[e] = 0.0
@@ -256,7 +275,7 @@ def _actuate(me, se, task, e, action, ws, nodes):
         most = task.pressure_rate * task.control_dt
         pressure = task.setpoint[e] + min(most, max(-most, command - task.setpoint[e]))
         if pressure != task.setpoint[e]:
-            set_rest_pressure(me, 0, pressure, x, se.v[0], se.energy[0], ws)
+            ramp_rest_pressure(me, 0, pressure, t, (task.steps[e] + 1) * task.control_dt, ws)
             task.setpoint[e] = pressure
             task.rest_radius[e] = rest_circle_radius(me, 0, pressure, n)
         return
@@ -269,7 +288,7 @@ def _actuate(me, se, task, e, action, ws, nodes):
         if x[i, 1] >= top - task.paddle_depth:
             nodes[count] = i
             count += 1
-    apply_impulse(me, 0, x, se.v[0], se.energy[0], ws, nodes, count, 0.0, -impulse)
+    spread_impulse(me, 0, nodes, count, 0.0, -impulse, t, t + task.paddle_strike_duration)
     task.impulse[e] = impulse
     task.struck[e] = True
 
@@ -306,7 +325,7 @@ def step_env(
     task.apex_count[e] = 0
     task.apex_error[e] = 0.0
     task.apex_height[e] = 0.0
-    _actuate(me, se, task, e, action, ws, nodes)
+    _actuate(me, se, task, e, action, clocks[e, CLOCK_T], ws, nodes)
     t_next = (task.steps[e] + 1) * task.control_dt
     rec = Recording(
         records.t[e], records.x[e], records.v[e], records.pressure[e], records.contact_force[e], events[e]
@@ -468,7 +487,7 @@ class BallBatch:
         self.scene = scene
         self.n_envs = n_envs
         self.n_nodes = scene.rings[0].n_nodes
-        self.model = _tiled_model(build_model(scene), n_envs)
+        self.model = _tiled_model(build_model(scene), n_envs, self.n_nodes)
         self.solver = build_solver(scene)
         barrier = bool(self.model.self_barrier)  # None in its place: the step compiles without it
         self.ws = build_workspace(self.n_nodes, barrier=barrier)
@@ -600,10 +619,12 @@ def compiled_entry(dispatcher: Any, args: tuple[Any, ...]) -> Callable[..., None
     return dispatcher.overloads[signature].entry_point
 
 
-def _tiled_model(model: Model, n_envs: int) -> Model:
-    """``model`` of a one-ring scene with its per-ring arrays repeated for ``n_envs`` envs (the rings
-    of different envs never meet: this is not a scene of many rings)."""
+def _tiled_model(model: Model, n_envs: int, n_nodes: int) -> Model:
+    """``model`` of a one-ring scene (``n_nodes`` nodes) with its per-ring arrays repeated for
+    ``n_envs`` envs (the rings of different envs never meet: this is not a scene of many rings),
+    and a :class:`Drive` for their actuation (set at every reset)."""
     tiled: dict[str, Any] = {
         name: np.repeat(getattr(model, name), n_envs, axis=0) for name in PER_RING_FIELDS
     }
-    return model._replace(**tiled)
+    tiled_model = model._replace(**tiled)
+    return tiled_model._replace(drive=build_drive(tiled_model, np.zeros(n_envs), n_nodes))

@@ -102,6 +102,14 @@ def coefficients(solver, h):
 
 
 @kernel
+def force_time(solver, stop, h):
+    """The time (s) at which a step of size ``h`` ending at ``stop`` evaluates its forces, where a
+    load that changes in time is taken: the step's end for backward Euler, ``t_{n+1-alpha_f} = stop -
+    alpha_f h`` for generalized-alpha."""
+    return stop - solver.alpha_f * h
+
+
+@kernel
 def arrival_factor(solver):
     """Reaction impulse per unit momentum that stops a node arriving at a ground: 1 for backward
     Euler, ``(1 - alpha_m) / beta`` for generalized-alpha (whose Newmark update reflects the node's

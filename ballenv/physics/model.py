@@ -25,7 +25,17 @@ from .barrier import PAIRS_PER_NODE
 from .collision import CONTACT_COLUMNS, CONTACTS_PER_NODE
 from .effects import EFFECTS
 from .effects.damping import DAMPING_CENTRE_OF_MASS, DAMPING_NONE, DAMPING_RIGID
-from .layout import ENERGY, EVENT, TALLY
+from .layout import (
+    ENERGY,
+    EVENT,
+    PUSH,
+    PUSH_T_END,
+    RAMP,
+    RAMP_AMOUNT_END,
+    RAMP_PRESSURE_END,
+    RAMP_T_END,
+    TALLY,
+)
 from .linalg import BAND_COLUMNS, MAX_LOW_RANK, SOLVE_COLUMNS, zigzag_positions
 
 CONTACT_NONE = 0
@@ -59,6 +69,19 @@ class Model(NamedTuple):
     reject_self_intersection: bool  # reject trial states in which a ring crosses itself
     self_barrier: bool  # the self-contact barrier of far wall parts (barrier.py)
     effect_parameters: np.ndarray  # (R,) records: one field per effect summed, its own parameters
+    drive: "Drive | None" = None  # actuation spread over time (drive.py); None: the step has none
+
+
+class Drive(NamedTuple):
+    """Actuation spread over time (``drive.py``), per ring: a gas ramp and a spread impulse.
+
+    A scene's :class:`Model` holds one only when something asks for it (``Simulation`` on the first
+    ramp or spread impulse, the env always); without it (``Model.drive`` None) the step compiles
+    none of its code, as with the self-contact barrier."""
+
+    ramp: np.ndarray  # (R, RAMP.size): the gas ramp (layout.RAMP)
+    push: np.ndarray  # (R, PUSH.size): the spread impulse (layout.PUSH)
+    pushed: np.ndarray  # (R, N) bool: the nodes sharing the spread impulse
 
 
 # Model fields with one entry per ring (the rest are scene-wide): a view of rings [a, b) slices these
@@ -245,6 +268,20 @@ def ground_array(grounds):
     return out
 
 
+def build_drive(model, pressures, n_nodes):
+    """A :class:`Drive` for ``model``'s rings (``n_nodes`` each), all off: each ring holds its
+    present gas amount ``model.gas_constant``, whose gauge pressure at rest is ``pressures`` (R,) Pa
+    (0 for a ring without gas)."""
+    n_rings = model.node_mass.shape[0]
+    ramp = np.zeros((n_rings, RAMP.size))
+    ramp[:, RAMP_T_END] = -np.inf
+    ramp[:, RAMP_AMOUNT_END] = model.gas_constant
+    ramp[:, RAMP_PRESSURE_END] = pressures
+    push = np.zeros((n_rings, PUSH.size))
+    push[:, PUSH_T_END] = -np.inf
+    return Drive(ramp=ramp, push=push, pushed=np.zeros((n_rings, n_nodes), dtype=np.bool_))
+
+
 def build_workspace(n_nodes, n_rings=1, effects=EFFECTS, barrier=True):
     """Scratch arrays for one ring's Newton solve and the scene's collision detection, allocated
     once per simulation (``effects``: the model's, for the size of the energy table; ``barrier``:
@@ -344,22 +381,31 @@ def empty_recording(capacity, n_rings, n_nodes, event_capacity):
 
 
 def rings_view(record, start, stop):
-    """``record`` (a :class:`Model` or :class:`State`) restricted to rings ``[start, stop)``: views of
-    its per-ring fields (``PER_RING_FIELDS`` of a Model, every field of a State), the rest shared.
-    Compiled from the field lists, so a field added to a record is sliced or shared by name."""
+    """``record`` (a :class:`Model`, :class:`State` or :class:`Drive`) restricted to rings
+    ``[start, stop)``: views of its per-ring fields (``PER_RING_FIELDS`` of a Model and the view of
+    its Drive, every field of a State or Drive), the rest shared. Compiled from the field lists, so a
+    field added to a record is sliced or shared by name."""
 
 
 def _per_ring_fields(cls):
     return PER_RING_FIELDS if cls is Model else cls._fields
 
 
+def _view_of(cls, name, field_type):
+    """The expression of field ``name`` (numba type ``field_type``) in a view of a ``cls`` record."""
+    if name in _per_ring_fields(cls):
+        return f"record.{name}[start:stop]"
+    if isinstance(field_type, types.BaseNamedTuple) and field_type.instance_class is Drive:
+        return f"rings_view(record.{name}, start, stop)"
+    return f"record.{name}"
+
+
 @overload(rings_view)
 def _rings_view(record, start, stop):
-    if not isinstance(record, types.BaseNamedTuple) or record.instance_class not in (Model, State):
+    if not isinstance(record, types.BaseNamedTuple) or record.instance_class not in (Model, State, Drive):
         return None
     cls = record.instance_class
-    sliced = _per_ring_fields(cls)
-    args = ", ".join(f"record.{f}[start:stop]" if f in sliced else f"record.{f}" for f in cls._fields)
-    scope = {"cls": cls}
+    args = ", ".join(_view_of(cls, f, t) for f, t in zip(cls._fields, record.types, strict=True))
+    scope = {"cls": cls, "rings_view": rings_view}
     exec(f"def impl(record, start, stop):\n    return cls({args})", scope)  # noqa: S102 - fields only
     return scope["impl"]
