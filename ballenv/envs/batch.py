@@ -153,7 +153,7 @@ def env_model(model, e):
 
 @kernel
 def env_state(state, e):
-    """The one-ring State of env ``e`` (views of its slices)."""
+    """The one-ring State (or Drive) of env ``e`` (views of its slices)."""
     return rings_view(state, e, e + 1)
 
 
@@ -163,6 +163,7 @@ def reset_env(
     solver,
     ws,
     state,
+    drive,
     clocks,
     counters,
     task,
@@ -179,9 +180,10 @@ def reset_env(
 ):
     """Put env ``e``'s ring on its inflated circle for gas ``pressure`` (Pa) at ``centre`` (m), turned
     by ``phase`` (rad), moving rigidly with ``velocity`` (m/s); target apex ``target`` (m). Writes its
-    observation as :func:`step_batch` does."""
+    observation as :func:`step_batch` does. No gas ramp or strike is under way (``drive``)."""
     me = env_model(model, e)
     se = env_state(state, e)
+    de = env_state(drive, e)
     x = se.x[0]
     v = se.v[0]
     n = x.shape[0]
@@ -199,8 +201,8 @@ def reset_env(
         se.contact_force[0, i, 1] = 0.0
     if model.pressurised[e]:
         set_gas(me, 0, pressure, n, ws)  # restart() counts the energy
-    hold_gas(me.drive, 0, me.gas_constant[0], pressure)  # no ramp or strike under way
-    stop_push(me.drive, 0)
+    hold_gas(me, de, 0, pressure, n)
+    stop_push(de, 0)
     restart(me, 0, x, v, se.a[0], se.active[0], se.energy[0], ws)
     se.energy[0, ENERGY_BUDGET] = se.energy[0, ENERGY_TOTAL]  # a new episode starts a new budget
     clocks[e, :] = 0.0
@@ -261,7 +263,7 @@ def _paddle_ready(task, e, x, v):
 
 
 @kernel(inline="always")
-def _actuate(me, se, task, e, action, t, ws, nodes):
+def _actuate(me, se, de, task, e, action, t, ws, nodes):
     """Start env ``e``'s actuation of the control step from ``t`` (s), spread over time
     (``physics/drive.py``; the stepper delivers it step by step): in pressure mode the gas ramp from
     the amount held to the setpoint moved toward the command, reached at the control step's end; in
@@ -275,7 +277,7 @@ def _actuate(me, se, task, e, action, t, ws, nodes):
         most = task.pressure_rate * task.control_dt
         pressure = task.setpoint[e] + min(most, max(-most, command - task.setpoint[e]))
         if pressure != task.setpoint[e]:
-            ramp_rest_pressure(me, 0, pressure, t, (task.steps[e] + 1) * task.control_dt, ws)
+            ramp_rest_pressure(me, de, 0, pressure, t, (task.steps[e] + 1) * task.control_dt, ws)
             task.setpoint[e] = pressure
             task.rest_radius[e] = rest_circle_radius(me, 0, pressure, n)
         return
@@ -288,7 +290,7 @@ def _actuate(me, se, task, e, action, t, ws, nodes):
         if x[i, 1] >= top - task.paddle_depth:
             nodes[count] = i
             count += 1
-    spread_impulse(me, 0, nodes, count, 0.0, -impulse, t, t + task.paddle_strike_duration)
+    spread_impulse(de, 0, nodes, count, 0.0, -impulse, t, t + task.paddle_strike_duration)
     task.impulse[e] = impulse
     task.struck[e] = True
 
@@ -312,20 +314,22 @@ def _tally(task, e, events, n_events):
 
 @kernel(inline="always")
 def step_env(
-    model, solver, ws, state, trial, clocks, counters, records, events, task, e, action, nodes, obs, low,
-    high, out,
+    model, solver, ws, state, trial, drive, clocks, counters, records, events, task, e, action, nodes, obs,
+    low, high, out,
 ):  # fmt: skip
-    """One control step of env ``e``: actuate with ``action`` in [-1, 1], advance to its next control
-    time, tally its flight apexes, then write its observation (``obs[e]``, unclipped; ``out[e]``,
-    clipped to ``[low, high]`` as float32) and reward and end (``task.reward``, ``task.end``, see
-    :func:`_outcome`). ``ws`` and ``nodes`` are scratch, carried over nothing."""
+    """One control step of env ``e``: actuate with ``action`` in [-1, 1] (its gas ramp or strike in
+    ``drive``), advance to its next control time, tally its flight apexes, then write its
+    observation (``obs[e]``, unclipped; ``out[e]``, clipped to ``[low, high]`` as float32) and reward
+    and end (``task.reward``, ``task.end``, see :func:`_outcome`). ``ws`` and ``nodes`` are scratch,
+    carried over nothing."""
     me = env_model(model, e)
     se = env_state(state, e)
     te = env_state(trial, e)
+    de = env_state(drive, e)
     task.apex_count[e] = 0
     task.apex_error[e] = 0.0
     task.apex_height[e] = 0.0
-    _actuate(me, se, task, e, action, clocks[e, CLOCK_T], ws, nodes)
+    _actuate(me, se, de, task, e, action, clocks[e, CLOCK_T], ws, nodes)
     t_next = (task.steps[e] + 1) * task.control_dt
     rec = Recording(
         records.t[e], records.x[e], records.v[e], records.pressure[e], records.contact_force[e], events[e]
@@ -333,7 +337,7 @@ def step_env(
     counters[e, COUNT_RECORDS] = 0
     while True:
         counters[e, COUNT_EVENTS] = 0
-        status = advance(me, solver, ws, se, te, clocks[e], counters[e], t_next, t_next, NO_OUTPUT, rec)
+        status = advance(me, solver, ws, se, te, clocks[e], counters[e], t_next, t_next, NO_OUTPUT, rec, de)
         _tally(task, e, events[e], counters[e, COUNT_EVENTS])
         if status != STATUS_BUFFER_FULL:
             break
@@ -348,8 +352,8 @@ def step_env(
 
 @kernel(nogil=True)
 def step_batch(
-    model, solver, ws, state, trial, clocks, counters, records, events, task, actions, active, nodes, obs,
-    low, high, out,
+    model, solver, ws, state, trial, drive, clocks, counters, records, events, task, actions, active, nodes,
+    obs, low, high, out,
 ):  # fmt: skip
     """One control step (:func:`step_env`) of every env ``e`` with ``active[e]``, with action
     ``actions[e]``, one after the other. Runs without the GIL: threads may step disjoint sets of
@@ -357,8 +361,8 @@ def step_batch(
     for e in range(actions.shape[0]):
         if active[e]:
             step_env(
-                model, solver, ws, state, trial, clocks, counters, records, events, task, e, actions[e],
-                nodes, obs, low, high, out,
+                model, solver, ws, state, trial, drive, clocks, counters, records, events, task, e,
+                actions[e], nodes, obs, low, high, out,
             )  # fmt: skip
 
 
@@ -487,7 +491,8 @@ class BallBatch:
         self.scene = scene
         self.n_envs = n_envs
         self.n_nodes = scene.rings[0].n_nodes
-        self.model = _tiled_model(build_model(scene), n_envs, self.n_nodes)
+        self.model = _tiled_model(build_model(scene), n_envs)
+        self.drive = build_drive(n_envs, self.n_nodes)  # each env's gas ramp and paddle strike
         self.solver = build_solver(scene)
         barrier = bool(self.model.self_barrier)  # None in its place: the step compiles without it
         self.ws = build_workspace(self.n_nodes, barrier=barrier)
@@ -551,8 +556,8 @@ class BallBatch:
     ) -> None:
         """Start env ``e`` afresh (see :func:`reset_env`)."""
         reset_env(
-            self.model, self.solver, self.ws, self.state, self.clocks, self.counters, self.task, e,
-            np.asarray(centre, dtype=float), np.asarray(velocity, dtype=float), float(phase),
+            self.model, self.solver, self.ws, self.state, self.drive, self.clocks, self.counters, self.task,
+            e, np.asarray(centre, dtype=float), np.asarray(velocity, dtype=float), float(phase),
             float(target), float(pressure), self.raw, self.low, self.high, self.obs,
         )  # fmt: skip
 
@@ -594,8 +599,9 @@ class BallBatch:
         self, ws: Workspace, nodes: NDArray[np.int64], actions: NDArray[np.float64], active: NDArray[np.bool_]
     ) -> None:
         args = (
-            self.model, self.solver, ws, self.state, self.trial, self.clocks, self.counters, self.records,
-            self.records.events, self.task, actions, active, nodes, self.raw, self.low, self.high, self.obs,
+            self.model, self.solver, ws, self.state, self.trial, self.drive, self.clocks, self.counters,
+            self.records, self.records.events, self.task, actions, active, nodes, self.raw, self.low,
+            self.high, self.obs,
         )  # fmt: skip
         if self._step_batch is None:
             self._step_batch = compiled_entry(step_batch, args)
@@ -619,12 +625,10 @@ def compiled_entry(dispatcher: Any, args: tuple[Any, ...]) -> Callable[..., None
     return dispatcher.overloads[signature].entry_point
 
 
-def _tiled_model(model: Model, n_envs: int, n_nodes: int) -> Model:
-    """``model`` of a one-ring scene (``n_nodes`` nodes) with its per-ring arrays repeated for
-    ``n_envs`` envs (the rings of different envs never meet: this is not a scene of many rings),
-    and a :class:`Drive` for their actuation (set at every reset)."""
+def _tiled_model(model: Model, n_envs: int) -> Model:
+    """``model`` of a one-ring scene with its per-ring arrays repeated for ``n_envs`` envs (the rings
+    of different envs never meet: this is not a scene of many rings)."""
     tiled: dict[str, Any] = {
         name: np.repeat(getattr(model, name), n_envs, axis=0) for name in PER_RING_FIELDS
     }
-    tiled_model = model._replace(**tiled)
-    return tiled_model._replace(drive=build_drive(tiled_model, np.zeros(n_envs), n_nodes))
+    return model._replace(**tiled)

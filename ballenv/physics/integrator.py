@@ -101,6 +101,12 @@ def coefficients(solver, h):
     return c_mass, c_x, c_v, solver.alpha_m
 
 
+@kernel(inline="always")
+def time_tolerance(solver):
+    """Times (s) closer than this are the same time to the step control (``1e-9 dt``)."""
+    return 1e-9 * solver.dt
+
+
 @kernel
 def force_time(solver, stop, h):
     """The time (s) at which a step of size ``h`` ending at ``stop`` evaluates its forces, where a

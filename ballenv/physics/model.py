@@ -31,8 +31,6 @@ from .layout import (
     PUSH,
     PUSH_T_END,
     RAMP,
-    RAMP_AMOUNT_END,
-    RAMP_PRESSURE_END,
     RAMP_T_END,
     TALLY,
 )
@@ -69,15 +67,14 @@ class Model(NamedTuple):
     reject_self_intersection: bool  # reject trial states in which a ring crosses itself
     self_barrier: bool  # the self-contact barrier of far wall parts (barrier.py)
     effect_parameters: np.ndarray  # (R,) records: one field per effect summed, its own parameters
-    drive: "Drive | None" = None  # actuation spread over time (drive.py); None: the step has none
 
 
 class Drive(NamedTuple):
     """Actuation spread over time (``drive.py``), per ring: a gas ramp and a spread impulse.
 
-    A scene's :class:`Model` holds one only when something asks for it (``Simulation`` on the first
-    ramp or spread impulse, the env always); without it (``Model.drive`` None) the step compiles
-    none of its code, as with the self-contact barrier."""
+    ``stepper.advance`` takes it as its own argument: None unless something asks for it
+    (``Simulation`` on the first ramp or spread impulse, the env always), and then the step
+    compiles none of its code, as with the self-contact barrier."""
 
     ramp: np.ndarray  # (R, RAMP.size): the gas ramp (layout.RAMP)
     push: np.ndarray  # (R, PUSH.size): the spread impulse (layout.PUSH)
@@ -268,15 +265,11 @@ def ground_array(grounds):
     return out
 
 
-def build_drive(model, pressures, n_nodes):
-    """A :class:`Drive` for ``model``'s rings (``n_nodes`` each), all off: each ring holds its
-    present gas amount ``model.gas_constant``, whose gauge pressure at rest is ``pressures`` (R,) Pa
-    (0 for a ring without gas)."""
-    n_rings = model.node_mass.shape[0]
+def build_drive(n_rings, n_nodes):
+    """A :class:`Drive` for ``n_rings`` rings of ``n_nodes`` nodes, all off; each ring's gas must be
+    held (``actuation.hold_gas``) before a ramp starts from it."""
     ramp = np.zeros((n_rings, RAMP.size))
     ramp[:, RAMP_T_END] = -np.inf
-    ramp[:, RAMP_AMOUNT_END] = model.gas_constant
-    ramp[:, RAMP_PRESSURE_END] = pressures
     push = np.zeros((n_rings, PUSH.size))
     push[:, PUSH_T_END] = -np.inf
     return Drive(ramp=ramp, push=push, pushed=np.zeros((n_rings, n_nodes), dtype=np.bool_))
@@ -382,22 +375,13 @@ def empty_recording(capacity, n_rings, n_nodes, event_capacity):
 
 def rings_view(record, start, stop):
     """``record`` (a :class:`Model`, :class:`State` or :class:`Drive`) restricted to rings
-    ``[start, stop)``: views of its per-ring fields (``PER_RING_FIELDS`` of a Model and the view of
-    its Drive, every field of a State or Drive), the rest shared. Compiled from the field lists, so a
-    field added to a record is sliced or shared by name."""
+    ``[start, stop)``: views of its per-ring fields (``PER_RING_FIELDS`` of a Model, every field of a
+    State or Drive), the rest shared. Compiled from the field lists, so a field added to a record is
+    sliced or shared by name."""
 
 
 def _per_ring_fields(cls):
     return PER_RING_FIELDS if cls is Model else cls._fields
-
-
-def _view_of(cls, name, field_type):
-    """The expression of field ``name`` (numba type ``field_type``) in a view of a ``cls`` record."""
-    if name in _per_ring_fields(cls):
-        return f"record.{name}[start:stop]"
-    if isinstance(field_type, types.BaseNamedTuple) and field_type.instance_class is Drive:
-        return f"rings_view(record.{name}, start, stop)"
-    return f"record.{name}"
 
 
 @overload(rings_view)
@@ -405,7 +389,8 @@ def _rings_view(record, start, stop):
     if not isinstance(record, types.BaseNamedTuple) or record.instance_class not in (Model, State, Drive):
         return None
     cls = record.instance_class
-    args = ", ".join(_view_of(cls, f, t) for f, t in zip(cls._fields, record.types, strict=True))
-    scope = {"cls": cls, "rings_view": rings_view}
+    sliced = _per_ring_fields(cls)
+    args = ", ".join(f"record.{f}[start:stop]" if f in sliced else f"record.{f}" for f in cls._fields)
+    scope = {"cls": cls}
     exec(f"def impl(record, start, stop):\n    return cls({args})", scope)  # noqa: S102 - fields only
     return scope["impl"]

@@ -66,6 +66,7 @@ from .layout import (
     STATUS_STEP_TOO_SMALL,
 )
 from .model import (
+    Drive,
     Model,
     Recording,
     Workspace,
@@ -271,6 +272,7 @@ class Simulation:
         record(self.model, 0, 0.0, self.state, self.rec)
         self.counters[COUNT_RECORDS] = 1
         self.failure: str | None = None
+        self.drive: Drive | None = None  # actuation spread over time (drive.py), made on first use
         # gauge pressure at rest (Pa) of each ring's gas amount, until a ramp takes it over (Drive.ramp)
         self._rest_pressures = np.array([r.pressure or 0.0 for r in scene.rings])
         self._wall = time.perf_counter() - start  # s: building, then advancing
@@ -308,7 +310,7 @@ class Simulation:
         while True:
             status = advance(
                 self.model, self.solver, self.ws, self.state, self.trial, self.clock, self.counters,
-                target, t_end, 0.0 if self.output_dt is None else self.output_dt, self.rec,
+                target, t_end, 0.0 if self.output_dt is None else self.output_dt, self.rec, self.drive,
             )  # fmt: skip
             if status != STATUS_BUFFER_FULL:
                 return status
@@ -369,13 +371,13 @@ class Simulation:
         pressure = check_gauge_pressure(owner, "pressure", pressure, spec, self.scene.atmospheric_pressure)
         duration = check_real(owner, "duration", duration, 0.0, 1e6, "s")
         if duration > 0.0:
-            ramp_rest_pressure(self._driven(), ring, pressure, self.t, self.t + duration, self.ws)
+            ramp_rest_pressure(self.model, self._driven(), ring, pressure, self.t, self.t + duration, self.ws)
             return
         s = self.state
         set_rest_pressure(self.model, ring, pressure, s.x[ring], s.v[ring], s.energy[ring], self.ws)
         self._rest_pressures[ring] = pressure
-        if self.model.drive is not None:
-            hold_gas(self.model.drive, ring, self.model.gas_constant[ring], pressure)
+        if self.drive is not None:
+            hold_gas(self.model, self.drive, ring, pressure, self.scene.rings[0].n_nodes)
 
     def apply_impulse(
         self, ring: int, nodes: ArrayLike, impulse: tuple[float, float], duration: float = 0.0
@@ -409,13 +411,15 @@ class Simulation:
             self.model, ring, s.x[ring], s.v[ring], s.energy[ring], self.ws, nodes, len(nodes), jx, jy
         )
 
-    def _driven(self) -> Model:
-        """The model with a :class:`model.Drive` (added on first use: the step compiles its code, and
-        a run that never asks for it compiles none)."""
-        if self.model.drive is None:
-            drive = build_drive(self.model, self._rest_pressures, self.scene.rings[0].n_nodes)
-            self.model = self.model._replace(drive=drive)
-        return self.model
+    def _driven(self) -> Drive:
+        """The run's :class:`model.Drive`, made on first use (the step then compiles its code; a run
+        that never asks for it has ``drive`` None and compiles none)."""
+        if self.drive is None:
+            n_nodes = self.scene.rings[0].n_nodes
+            self.drive = build_drive(len(self.scene.rings), n_nodes)
+            for ring, pressure in enumerate(self._rest_pressures):
+                hold_gas(self.model, self.drive, ring, float(pressure), n_nodes)
+        return self.drive
 
     def stats(self) -> SimulationStats:
         """:class:`SimulationStats` so far."""

@@ -6,7 +6,7 @@ the step size, output times, the fixed grid and actuation windows), the actuatio
 of every ring (collision impulses, Newton's iteration with the contact set, :mod:`.newton`), the
 acceptance tests (Newton failure, self-intersection, energy budget, ring intrusion, contact
 impulse), then the bookkeeping of a rejected (:func:`step_outcome`) or an accepted step
-(:func:`accept`, events, records, the end of a gas ramp) and the next step size. Counters, clock
+(:func:`accept`, the end of a gas ramp, events, records) and the next step size. Counters, clock
 and energy columns are the named layouts of :mod:`.layout`.
 """
 
@@ -15,11 +15,11 @@ import math
 from .assembly import ring_force
 from .collision import collision_impulses, collision_step_limit, rings_intrude, self_intersects
 from .contact import FREE
-from .drive import drive_accepted, drive_landing, drive_step, time_tolerance
+from .drive import drive_landing, drive_step
 from .effects.gas import ring_pressure
 from .energy import free_energy, within_energy_budget
 from .events import detect_events
-from .integrator import arrival_factor, carries_acceleration
+from .integrator import arrival_factor, carries_acceleration, time_tolerance
 from .jit import copy_into, kernel
 from .layout import (
     CLOCK_COLLISION_GAIN,
@@ -318,7 +318,7 @@ def accept(model, solver, ws, state, trial, clock, counters, h, stop, at_grid, r
 
 
 @kernel
-def advance(model, solver, ws, state, trial, clock, counters, t_pause, t_end, output_dt, rec):
+def advance(model, solver, ws, state, trial, clock, counters, t_pause, t_end, output_dt, rec, drive):
     """Step ``state`` from ``clock[CLOCK_T]`` to ``t_end``, pausing (returning) after the first step
     that reaches ``t_pause`` (<= ``t_end``; for progress reports).
 
@@ -329,6 +329,10 @@ def advance(model, solver, ws, state, trial, clock, counters, t_pause, t_end, ou
     halved the step below ``dt_min``; ``counters[COUNT_REJECTION]`` says why the last one was) or
     STATUS_IMPULSE_AT_DT_MIN (the contact impulse exceeds ``impulse_tol`` even at ``dt_min``); on
     failure the state is the last accepted one.
+
+    ``drive``: actuation spread over time (a ``model.Drive``: gas ramps, spread impulses; each
+    step lands on their windows' ends and first takes its share, :mod:`.drive`), or None: numba
+    then prunes those calls and compiles none of their code.
 
     Step control: a rejected step (see :func:`try_step`) is retried with half the step, adaptive or
     not. With ring
@@ -348,9 +352,12 @@ def advance(model, solver, ws, state, trial, clock, counters, t_pause, t_end, ou
         if model.collide:
             limit = collision_step_limit(state.x, state.v, model.thickness, clock[CLOCK_H], ws.collision)
             clock[CLOCK_H] = max(min(clock[CLOCK_H], limit), solver.dt_min)
-        landing = drive_landing(solver, clock[CLOCK_T], model.drive)
+        landing = math.inf
+        if drive is not None:  # (pruned by numba for a drive of None: no code)
+            landing = drive_landing(solver, clock[CLOCK_T], drive)
         stop, at_end, at_out, at_grid = step_end(solver, clock, counters, t_end, output_dt, landing)
-        drive_step(model, solver, state, clock[CLOCK_T], stop, ws, model.drive)
+        if drive is not None:
+            drive_step(model, solver, state, clock[CLOCK_T], stop, ws, drive)
         h = stop - clock[CLOCK_T]
         its, impulse_ratio, error = try_step(model, solver, state, trial, h, ws)
         error_factor = math.inf if error == 0.0 else error ** -error_exponent(solver)
@@ -361,7 +368,8 @@ def advance(model, solver, ws, state, trial, clock, counters, t_pause, t_end, ou
         if status != STATUS_DONE:
             return status
         accept(model, solver, ws, state, trial, clock, counters, h, stop, at_grid, ratio, rec)
-        drive_accepted(model, solver, state, stop, ws, model.drive)
+        if drive is not None:
+            drive_step(model, solver, state, stop, stop, ws, drive)  # a ramp ending here: its end amount
         if output_dt == 0.0 or at_out or at_end:
             record(model, counters[COUNT_RECORDS], stop, state, rec)
             counters[COUNT_RECORDS] += 1

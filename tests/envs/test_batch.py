@@ -12,7 +12,7 @@ import ballenv  # noqa: F401  (registers the env)
 from ballenv.controllers import PaddleDribble, PressurePump
 from ballenv.envs.batch import REWARD_AT_MARGIN, env_model, height_reward
 from ballenv.envs.inflated_ball import InflatedBallEnv
-from ballenv.physics.actuation import rest_amount
+from ballenv.physics.actuation import set_gas
 from ballenv.physics.layout import CLOCK_T, PUSH_DELIVERED, PUSH_T_END, PUSH_T_START, RAMP_T_END
 from ballenv.physics.model import build_workspace
 from ballenv.physics.ring import total_mass
@@ -142,7 +142,7 @@ def test_the_pump_ramps_the_gas_to_its_setpoint_by_the_end_of_each_control_step(
     env.reset(seed=3)
     batch = env._batch
     n = env.config.n_nodes
-    model = env_model(batch.model, 0)
+    model = env_model(batch.model, 0)._replace(gas_constant=np.zeros(1), rest_energy=np.zeros(1))
     ws = build_workspace(n)
     budget, setpoint = batch.state.energy[0, 2], env.config.initial_pressure
     for k, action in enumerate([1.0, 1.0, -1.0] + [1.0] * 5):  # 34, 38, 34, 38, ... 50, 50 kPa
@@ -151,9 +151,11 @@ def test_the_pump_ramps_the_gas_to_its_setpoint_by_the_end_of_each_control_step(
         assert not terminated
         moved, setpoint = info["pressure_setpoint"] != setpoint, info["pressure_setpoint"]
         # the amount of the new setpoint exactly, reached at the end of the control step
-        assert batch.model.gas_constant[0] == rest_amount(model, 0, setpoint, n, ws)
+        set_gas(model, 0, setpoint, n, ws)  # what setting it at once would give
+        assert batch.model.gas_constant[0] == model.gas_constant[0]
+        assert batch.model.rest_energy[0] == model.rest_energy[0]
         assert (batch.model.gas_constant[0] != held) == moved
-        assert batch.model.drive.ramp[0, RAMP_T_END] == -np.inf  # the ramp is over
+        assert batch.drive.ramp[0, RAMP_T_END] == -np.inf  # the ramp is over
         assert batch.clocks[0, CLOCK_T] == pytest.approx((k + 1) * env.dt, abs=1e-15)
         assert (batch.state.energy[0, 2] != budget) == moved  # the pump's work was credited
         budget = batch.state.energy[0, 2]
@@ -185,11 +187,11 @@ def test_a_paddle_strike_delivers_exactly_its_impulse_over_its_duration(duration
     weight = total_mass(env.config.ring(env.config.initial_pressure)) * 9.81
     change = after - before - np.array([0.0, -weight * env.dt])
     np.testing.assert_allclose(change, [0.0, -0.15], rtol=0.0, atol=1e-13)
-    push = batch.model.drive.push[0]
+    push = batch.drive.push[0]
     assert push[PUSH_T_START] == pytest.approx(env.dt, abs=1e-15)
     assert push[PUSH_T_END] == push[PUSH_T_START] + duration
     assert push[PUSH_DELIVERED] == 1.0
-    np.testing.assert_array_equal(batch.model.drive.pushed[0], near_top)  # the same nodes as at once
+    np.testing.assert_array_equal(batch.drive.pushed[0], near_top)  # the same nodes as at once
 
 
 def test_a_spread_strike_is_a_different_motion_of_the_same_momentum():

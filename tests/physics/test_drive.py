@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from ballenv.physics import Ring, Scene
-from ballenv.physics.actuation import rest_amount, rest_pressure_of
+from ballenv.physics.actuation import set_gas
 from ballenv.physics.effects.gas import gas_energy
 from ballenv.physics.geometry import polygon_area
 from ballenv.physics.layout import ENERGY_BUDGET
@@ -20,6 +20,15 @@ def _falling_scene(integrator, adaptive, dt=1e-3):
     """A ring in the air under gravity, no ground: only gravity changes its momentum."""
     ring = Ring(n_nodes=32, pressure=30e3, position=(0.0, 1.0), velocity=(0.2, 0.0), angular_velocity=3.0)
     return Scene(rings=[ring], gravity=9.81, integrator=integrator, adaptive=adaptive, dt=dt)
+
+
+def _rest_gas(scene, pressure):
+    """(amount (Pa m^2), rest energy (J)) of gauge pressure ``pressure`` (Pa) at rest in the scene's
+    first ring (as ``set_rest_pressure`` sets them)."""
+    model = build_model(scene)
+    n = scene.rings[0].n_nodes
+    set_gas(model, 0, pressure, n, build_workspace(n))
+    return model.gas_constant[0], model.rest_energy[0]
 
 
 def _momentum(sim):
@@ -90,9 +99,7 @@ def test_gas_ramp_holds_the_amount_of_each_steps_force_time_and_the_setpoint_at_
     assert sim.model.gas_constant[0] == amount0  # nothing changes before a step
     assert sim.advance(t0 + duration)
     end_amount = sim.model.gas_constant[0]
-    ws = build_workspace(32)
-    model = build_model(sim.scene)
-    assert end_amount == rest_amount(model, 0, 45e3, 32, ws)  # the setpoint's amount, to the bit
+    assert (end_amount, sim.model.rest_energy[0]) == _rest_gas(sim.scene, 45e3)  # the setpoint's, to the bit
     # every step in between held the linear value at its force-evaluation time t_f = stop - alpha_f h
     traj = sim.trajectory()
     t = traj.t[start:]
@@ -122,7 +129,7 @@ def test_energy_budget_is_credited_with_the_pump_work_of_each_step(integrator):
     assert sim.stats().rejected_steps == 0
     traj = sim.trajectory()
     t, x = traj.t[start:], traj.x[start:, 0]
-    amount1 = rest_amount(build_model(sim.scene), 0, 12e3, 32, build_workspace(32))
+    amount1 = _rest_gas(sim.scene, 12e3)[0]
     width, p_atm, alpha_f = sim.scene.rings[0].width, sim.scene.atmospheric_pressure, ALPHA_F[integrator]
 
     def gas(k, amount):
@@ -142,10 +149,53 @@ def test_energy_budget_is_credited_with_the_pump_work_of_each_step(integrator):
     assert budget - budget0 == pytest.approx(work, rel=1e-12)
 
 
-@pytest.mark.parametrize("pressure", [-20e3, 10e3, 45e3])
-def test_rest_pressure_of_an_amount_inverts_the_rest_amount(pressure):
-    scene = Scene(rings=[Ring(n_nodes=24, pressure=30e3)], gravity=0.0)
-    model = build_model(scene)
-    amount = rest_amount(model, 0, pressure, 24, build_workspace(24))
-    for guess in (30e3, pressure + 5e3, pressure - 5e3):
-        assert rest_pressure_of(model, 0, amount, guess, 24) == pytest.approx(pressure, rel=1e-10, abs=1e-6)
+@pytest.mark.parametrize(
+    "p0, p1, bound",  # bound: of the rest energy's change over the ramp
+    [(30e3, 34e3, 1e-6), (26e3, 22e3, 1e-6), (30e3, 40e3, 1e-5), (-20e3, 5e3, 1e-4), (10e3, 50e3, 5e-4)],
+)
+def test_the_rest_energy_follows_the_ramps_amount(p0, p1, bound):
+    """Inside a ramp the ring's rest energy (which scales the energy guard's tolerance) is that of
+    the inflated circle of the amount it holds (its exact rest pressure found by bisection, its rest
+    energy as ``set_rest_pressure`` sets it), to the Hermite interpolant's error, fourth order in the
+    amount's change: 2.6e-7 of the change for the env's 4 kPa steps (8 % of the amount), 2.6e-4 for
+    10 to 50 kPa (2.2 times the amount)."""
+    scene = Scene(rings=[Ring(n_nodes=32, pressure=p0)], gravity=0.0, integrator="backward_euler", dt=1e-3)
+    sim = Simulation(scene, output_dt=None)
+    sim.set_rest_pressure(0, p1, duration=0.01)
+    for t in (0.002, 0.005, 0.007):
+        assert sim.advance(t)
+        amount, rest = sim.model.gas_constant[0], sim.model.rest_energy[0]
+        low, high = min(p0, p1), max(p0, p1)
+        for _ in range(200):
+            mid = 0.5 * (low + high)
+            low, high = (mid, high) if _rest_gas(scene, mid)[0] < amount else (low, mid)
+        exact = _rest_gas(scene, 0.5 * (low + high))[1]
+        change = abs(_rest_gas(scene, p1)[1] - _rest_gas(scene, p0)[1])
+        assert abs(rest - exact) <= bound * change, (t, rest - exact, change)
+
+
+def test_a_run_without_spread_actuation_has_no_drive_and_an_idle_drive_changes_no_bit():
+    scene = _falling_scene("generalized_alpha", adaptive=False)
+    plain = Simulation(scene, output_dt=None)
+    assert plain.drive is None  # its step compiles none of drive.py
+    driven = Simulation(scene, output_dt=None)
+    for sim in (plain, driven):
+        assert sim.advance(0.004)
+    driven.apply_impulse(0, _top_nodes(driven), (0.0, 0.0), duration=1e-3)  # one grid step, nothing in it
+    assert driven.drive is not None
+    for sim in (plain, driven):
+        assert sim.advance(0.02)
+    a, b = plain.trajectory(), driven.trajectory()
+    for name in ("t", "x", "v", "pressure"):
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
+    np.testing.assert_array_equal(plain.state.energy, driven.state.energy)
+
+
+@pytest.mark.parametrize("duration", [-1e-3, float("nan"), 2e6])
+def test_a_duration_out_of_range_names_the_argument_and_its_range(duration):
+    sim = Simulation(_falling_scene("backward_euler", adaptive=False))
+    message = r"is out of range: must be a finite number in \[0, 1e\+06\] s"
+    with pytest.raises(ValueError, match=r"^Simulation\.set_rest_pressure\.duration = .*" + message):
+        sim.set_rest_pressure(0, 40e3, duration=duration)
+    with pytest.raises(ValueError, match=r"^Simulation\.apply_impulse\.duration = .*" + message):
+        sim.apply_impulse(0, [0, 1], (0.0, -0.1), duration=duration)
