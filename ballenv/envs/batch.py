@@ -1,4 +1,4 @@
-"""Many bouncing balls advanced in one compiled call: the physics behind InflatedBall-v1.
+"""Many bouncing balls advanced in one compiled call: the physics behind InflatedBall-v2.
 
 Every env holds one ring above one flat ground; the rings share material and numerical settings
 and differ in state, gas and target. One :class:`Model` with per-ring arrays of length E holds all
@@ -6,8 +6,9 @@ envs; env ``e`` is advanced by the same ``stepper.advance`` as ``simulate()``, o
 slices, with its own clock and step size. A batch of E envs therefore gives the same numbers as E
 batches of one (the single env is a batch of one).
 
-A control step of env ``e``: apply the action (set the gas, or let the paddle strike), advance to
-``(k + 1) * control_dt``, and tally the apex events of the interval. Only an apex in flight counts
+A control step of env ``e``: start the action (a gas ramp to the new setpoint, or a paddle strike
+spread over its duration: ``physics/drive.py``), advance to ``(k + 1) * control_dt`` (the steps
+deliver it), and tally the apex events of the interval. Only an apex in flight counts
 (after a lift-off, before the next touchdown): the centre of mass also turns round inside a squash.
 """
 
@@ -20,7 +21,15 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..physics.actuation import apply_impulse, rest_circle_radius, restart, set_gas, set_rest_pressure
+from ..physics.actuation import (
+    hold_gas,
+    ramp_rest_pressure,
+    rest_circle_radius,
+    restart,
+    set_gas,
+    spread_impulse,
+    stop_push,
+)
 from ..physics.contact import FREE
 from ..physics.effects.gas import ring_pressure
 from ..physics.geometry import centre_of_mass
@@ -28,6 +37,7 @@ from ..physics.integrator import build_solver
 from ..physics.jit import kernel, python_entry
 from ..physics.layout import (
     CLOCK_H,
+    CLOCK_T,
     COUNT_EVENTS,
     COUNT_RECORDS,
     ENERGY_BUDGET,
@@ -50,6 +60,7 @@ from ..physics.model import (
     Model,
     Recording,
     Workspace,
+    build_drive,
     build_model,
     build_workspace,
     empty_state,
@@ -108,6 +119,7 @@ class Task(NamedTuple):
     paddle_max_impulse: float  # N s, for action +1 (-1: no strike)
     paddle_reach: float  # m: the paddle strikes when the ball's top is within this of its height
     paddle_depth: float  # m: it touches the nodes within this of the ball's top
+    paddle_strike_duration: float  # s: a strike delivers its impulse at a constant rate over this
     ground_height: float  # m
     gravity: float  # m/s^2
     reward_margin: float  # relative apex error at which the reward has fallen to REWARD_AT_MARGIN
@@ -141,7 +153,7 @@ def env_model(model, e):
 
 @kernel
 def env_state(state, e):
-    """The one-ring State of env ``e`` (views of its slices)."""
+    """The one-ring State (or Drive) of env ``e`` (views of its slices)."""
     return rings_view(state, e, e + 1)
 
 
@@ -151,6 +163,7 @@ def reset_env(
     solver,
     ws,
     state,
+    drive,
     clocks,
     counters,
     task,
@@ -167,9 +180,10 @@ def reset_env(
 ):
     """Put env ``e``'s ring on its inflated circle for gas ``pressure`` (Pa) at ``centre`` (m), turned
     by ``phase`` (rad), moving rigidly with ``velocity`` (m/s); target apex ``target`` (m). Writes its
-    observation as :func:`step_batch` does."""
+    observation as :func:`step_batch` does. No gas ramp or strike is under way (``drive``)."""
     me = env_model(model, e)
     se = env_state(state, e)
+    de = env_state(drive, e)
     x = se.x[0]
     v = se.v[0]
     n = x.shape[0]
@@ -187,6 +201,8 @@ def reset_env(
         se.contact_force[0, i, 1] = 0.0
     if model.pressurised[e]:
         set_gas(me, 0, pressure, n, ws)  # restart() counts the energy
+    hold_gas(me, de, 0, pressure, n)
+    stop_push(de, 0)
     restart(me, 0, x, v, se.a[0], se.active[0], se.energy[0], ws)
     se.energy[0, ENERGY_BUDGET] = se.energy[0, ENERGY_TOTAL]  # a new episode starts a new budget
     clocks[e, :] = 0.0
@@ -247,7 +263,12 @@ def _paddle_ready(task, e, x, v):
 
 
 @kernel(inline="always")
-def _actuate(me, se, task, e, action, ws, nodes):
+def _actuate(me, se, de, task, e, action, t, ws, nodes):
+    """Start env ``e``'s actuation of the control step from ``t`` (s), spread over time
+    (``physics/drive.py``; the stepper delivers it step by step): in pressure mode the gas ramp from
+    the amount held to the setpoint moved toward the command, reached at the control step's end; in
+    paddle mode a strike spread over ``paddle_strike_duration`` on the nodes within
+    ``paddle_depth`` of the top now."""
     x = se.x[0]
     n = x.shape[0]
     task.impulse[e] = 0.0
@@ -256,7 +277,7 @@ def _actuate(me, se, task, e, action, ws, nodes):
         most = task.pressure_rate * task.control_dt
         pressure = task.setpoint[e] + min(most, max(-most, command - task.setpoint[e]))
         if pressure != task.setpoint[e]:
-            set_rest_pressure(me, 0, pressure, x, se.v[0], se.energy[0], ws)
+            ramp_rest_pressure(me, de, 0, pressure, t, (task.steps[e] + 1) * task.control_dt, ws)
             task.setpoint[e] = pressure
             task.rest_radius[e] = rest_circle_radius(me, 0, pressure, n)
         return
@@ -269,7 +290,7 @@ def _actuate(me, se, task, e, action, ws, nodes):
         if x[i, 1] >= top - task.paddle_depth:
             nodes[count] = i
             count += 1
-    apply_impulse(me, 0, x, se.v[0], se.energy[0], ws, nodes, count, 0.0, -impulse)
+    spread_impulse(de, 0, nodes, count, 0.0, -impulse, t, t + task.paddle_strike_duration)
     task.impulse[e] = impulse
     task.struck[e] = True
 
@@ -293,20 +314,22 @@ def _tally(task, e, events, n_events):
 
 @kernel(inline="always")
 def step_env(
-    model, solver, ws, state, trial, clocks, counters, records, events, task, e, action, nodes, obs, low,
-    high, out,
+    model, solver, ws, state, trial, drive, clocks, counters, records, events, task, e, action, nodes, obs,
+    low, high, out,
 ):  # fmt: skip
-    """One control step of env ``e``: actuate with ``action`` in [-1, 1], advance to its next control
-    time, tally its flight apexes, then write its observation (``obs[e]``, unclipped; ``out[e]``,
-    clipped to ``[low, high]`` as float32) and reward and end (``task.reward``, ``task.end``, see
-    :func:`_outcome`). ``ws`` and ``nodes`` are scratch, carried over nothing."""
+    """One control step of env ``e``: actuate with ``action`` in [-1, 1] (its gas ramp or strike in
+    ``drive``), advance to its next control time, tally its flight apexes, then write its
+    observation (``obs[e]``, unclipped; ``out[e]``, clipped to ``[low, high]`` as float32) and reward
+    and end (``task.reward``, ``task.end``, see :func:`_outcome`). ``ws`` and ``nodes`` are scratch,
+    carried over nothing."""
     me = env_model(model, e)
     se = env_state(state, e)
     te = env_state(trial, e)
+    de = env_state(drive, e)
     task.apex_count[e] = 0
     task.apex_error[e] = 0.0
     task.apex_height[e] = 0.0
-    _actuate(me, se, task, e, action, ws, nodes)
+    _actuate(me, se, de, task, e, action, clocks[e, CLOCK_T], ws, nodes)
     t_next = (task.steps[e] + 1) * task.control_dt
     rec = Recording(
         records.t[e], records.x[e], records.v[e], records.pressure[e], records.contact_force[e], events[e]
@@ -314,7 +337,7 @@ def step_env(
     counters[e, COUNT_RECORDS] = 0
     while True:
         counters[e, COUNT_EVENTS] = 0
-        status = advance(me, solver, ws, se, te, clocks[e], counters[e], t_next, t_next, NO_OUTPUT, rec)
+        status = advance(me, solver, ws, se, te, clocks[e], counters[e], t_next, t_next, NO_OUTPUT, rec, de)
         _tally(task, e, events[e], counters[e, COUNT_EVENTS])
         if status != STATUS_BUFFER_FULL:
             break
@@ -329,8 +352,8 @@ def step_env(
 
 @kernel(nogil=True)
 def step_batch(
-    model, solver, ws, state, trial, clocks, counters, records, events, task, actions, active, nodes, obs,
-    low, high, out,
+    model, solver, ws, state, trial, drive, clocks, counters, records, events, task, actions, active, nodes,
+    obs, low, high, out,
 ):  # fmt: skip
     """One control step (:func:`step_env`) of every env ``e`` with ``active[e]``, with action
     ``actions[e]``, one after the other. Runs without the GIL: threads may step disjoint sets of
@@ -338,8 +361,8 @@ def step_batch(
     for e in range(actions.shape[0]):
         if active[e]:
             step_env(
-                model, solver, ws, state, trial, clocks, counters, records, events, task, e, actions[e],
-                nodes, obs, low, high, out,
+                model, solver, ws, state, trial, drive, clocks, counters, records, events, task, e,
+                actions[e], nodes, obs, low, high, out,
             )  # fmt: skip
 
 
@@ -469,6 +492,7 @@ class BallBatch:
         self.n_envs = n_envs
         self.n_nodes = scene.rings[0].n_nodes
         self.model = _tiled_model(build_model(scene), n_envs)
+        self.drive = build_drive(n_envs, self.n_nodes)  # each env's gas ramp and paddle strike
         self.solver = build_solver(scene)
         barrier = bool(self.model.self_barrier)
         self.ws = self._scratch_workspace(barrier)
@@ -540,8 +564,8 @@ class BallBatch:
     ) -> None:
         """Start env ``e`` afresh (see :func:`reset_env`)."""
         reset_env(
-            self.model, self.solver, self.ws, self.state, self.clocks, self.counters, self.task, e,
-            np.asarray(centre, dtype=float), np.asarray(velocity, dtype=float), float(phase),
+            self.model, self.solver, self.ws, self.state, self.drive, self.clocks, self.counters, self.task,
+            e, np.asarray(centre, dtype=float), np.asarray(velocity, dtype=float), float(phase),
             float(target), float(pressure), self.raw, self.low, self.high, self.obs,
         )  # fmt: skip
 
@@ -583,8 +607,9 @@ class BallBatch:
         self, ws: Workspace, nodes: NDArray[np.int64], actions: NDArray[np.float64], active: NDArray[np.bool_]
     ) -> None:
         args = (
-            self.model, self.solver, ws, self.state, self.trial, self.clocks, self.counters, self.records,
-            self.records.events, self.task, actions, active, nodes, self.raw, self.low, self.high, self.obs,
+            self.model, self.solver, ws, self.state, self.trial, self.drive, self.clocks, self.counters,
+            self.records, self.records.events, self.task, actions, active, nodes, self.raw, self.low,
+            self.high, self.obs,
         )  # fmt: skip
         if self._step_batch is None:
             self._step_batch = compiled_entry(step_batch, args)

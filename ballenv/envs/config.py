@@ -1,4 +1,4 @@
-"""The keyword arguments of InflatedBall-v1, validated once, and what both envs derive from them:
+"""The keyword arguments of InflatedBall-v2, validated once, and what both envs derive from them:
 the physics scene, the task settings, the observation bounds, and the reward and episode end."""
 
 from __future__ import annotations
@@ -30,7 +30,7 @@ FAILURES = {
 
 @dataclass(frozen=True)
 class BallEnvConfig:
-    """Keyword arguments of InflatedBall-v1 (SI units); see the env's Arguments table."""
+    """Keyword arguments of InflatedBall-v2 (SI units); see the env's Arguments table."""
 
     action_mode: str = "pressure"
     fidelity: str = "fast"
@@ -43,6 +43,7 @@ class BallEnvConfig:
     paddle_max_impulse: float = 0.15
     paddle_reach: float = 0.4
     paddle_depth: float = 0.06
+    paddle_strike_duration: float = 3e-3
     radius: float = 0.12
     youngs_modulus: float = 10e6
     thickness: float = 2e-3
@@ -58,7 +59,7 @@ class BallEnvConfig:
     rest_height: float = 0.01
 
     def __post_init__(self) -> None:
-        o = "InflatedBall-v1"
+        o = "InflatedBall-v2"
         s = object.__setattr__
         check_choice(o, "action_mode", self.action_mode, tuple(ACTION_MODES))
         check_choice(o, "fidelity", self.fidelity, tuple(FIDELITY_PRESETS))
@@ -78,6 +79,14 @@ class BallEnvConfig:
             ("rest_height", 0.0, 1.0, "m"),
         ):
             s(self, name, check_real(o, name, getattr(self, name), lo, hi, unit))
+        s(
+            self,
+            "paddle_strike_duration",
+            check_real(
+                o, "paddle_strike_duration", self.paddle_strike_duration, 0.0, self.control_dt,
+                "s (at most one control step, 1 / control_frequency)", low_open=True,
+            ),
+        )  # fmt: skip
         margin = check_real(o, "reward_margin", self.reward_margin, 0.0, 100.0, "", low_open=True)
         s(self, "reward_margin", margin)
         s(self, "gravity", check_real(o, "gravity", self.gravity, 0.0, 1000.0, "m/s^2", low_open=True))
@@ -141,6 +150,7 @@ class BallEnvConfig:
             "paddle_max_impulse": self.paddle_max_impulse,
             "paddle_reach": self.paddle_reach,
             "paddle_depth": self.paddle_depth,
+            "paddle_strike_duration": self.paddle_strike_duration,
             "ground_height": 0.0,
             "gravity": self.gravity,
             "reward_margin": self.reward_margin,
@@ -166,7 +176,7 @@ class BallEnvConfig:
         unknown = sorted(set(kwargs) - known)
         if unknown:
             raise TypeError(
-                f"InflatedBall-v1 got unknown keyword arguments {unknown}; known: {sorted(known)}"
+                f"InflatedBall-v2 got unknown keyword arguments {unknown}; known: {sorted(known)}"
             )
         return cls(**kwargs)
 
@@ -177,7 +187,7 @@ def _check_wall(config: BallEnvConfig) -> None:
     try:
         config.ring(None)
     except ValueError as err:
-        raise ValueError(str(err).replace("Ring.", "InflatedBall-v1.", 1)) from None
+        raise ValueError(str(err).replace("Ring.", "InflatedBall-v2.", 1)) from None
 
 
 def _check_wall_holds(config: BallEnvConfig, name: str, pressure: float) -> None:
@@ -186,7 +196,7 @@ def _check_wall_holds(config: BallEnvConfig, name: str, pressure: float) -> None
     held = burst_pressure(config.radius, config.n_nodes, config.youngs_modulus, config.thickness)
     if pressure > held:
         raise ValueError(
-            f"InflatedBall-v1.{name} = {getattr(config, name)!r} is out of range: {pressure:g} Pa must be "
+            f"InflatedBall-v2.{name} = {getattr(config, name)!r} is out of range: {pressure:g} Pa must be "
             f"at most {held:.6g} Pa, the gauge pressure that stretches the wall (radius = {config.radius:g} "
             f"m, youngs_modulus = {config.youngs_modulus:g} Pa, thickness = {config.thickness:g} m) by "
             f"100 %; beyond, the ball bursts: lower {name} or stiffen the wall (youngs_modulus, thickness)"
@@ -217,7 +227,7 @@ def parse_actions(actions: ArrayLike, count: int, what: str) -> NDArray[np.float
             return a
     shape = "(1,)" if count == 1 else f"({count}, 1)"
     raise ValueError(
-        f"InflatedBall-v1 {what} = {actions!r} is invalid: must be {count} finite real number"
+        f"InflatedBall-v2 {what} = {actions!r} is invalid: must be {count} finite real number"
         f"{'s' if count > 1 else ''} (shape {shape}; values outside [-1, 1] are clipped)"
     )
 
@@ -227,7 +237,7 @@ def check_reset(has_reset: bool, call: str) -> None:
     reset: until then the ball has no state (its arrays are zeros)."""
     if not has_reset:
         raise ResetNeeded(
-            f"InflatedBall-v1 {call}() was called before reset(): call reset() first, which places "
+            f"InflatedBall-v2 {call}() was called before reset(): call reset() first, which places "
             "the ball and draws the episode's target"
         )
 

@@ -1,4 +1,4 @@
-"""InflatedBall-v1: keep an inflated elastic ball bouncing to a target apex height."""
+"""InflatedBall-v2: keep an inflated elastic ball bouncing to a target apex height."""
 
 from __future__ import annotations
 
@@ -38,15 +38,18 @@ class InflatedBallEnv(Env[NDArray[np.float32], NDArray[np.float32]], EzPickle):
     | paddle   | the downward impulse J = (a + 1)/2 * paddle_max_impulse of the next strike    | N s |
 
     Pressure: the gas setpoint moves toward the commanded value at most ``pressure_rate`` (a pump's
-    flow; instant jumps of the gas ring the ball's breathing mode like a bell) and is applied at the
-    start of the control step; the gas law then sets the pressure as the ball deforms, so raising it
-    while the ball is squashed does work ``p dA`` as it re-expands.
+    flow; instant jumps of the gas ring the ball's breathing mode like a bell), and the gas amount
+    follows it as a ramp: linear in time over the control step, from the amount held at its start
+    to the setpoint's at its end (each simulator step holds the amount of its own time); the gas
+    law then sets the pressure as the ball deforms, so raising it while the ball is squashed does
+    work ``p dA`` as it re-expands.
     Paddle: the paddle hovers at ``target + r`` (where the ball's top is at the target apex); it
     strikes only a falling ball (centre of mass moving down) whose top is within ``paddle_reach``
     of it, at most once per flight (a second strike waits until the ball has touched the ground),
     as a dribbling hand meets the ball coming down, and then shares ``J`` equally among the nodes
-    within ``paddle_depth`` of the top: the ball's momentum changes by exactly J. Action -1 lets the
-    ball pass unstruck (it may still be struck later in the same flight).
+    within ``paddle_depth`` of the top when it strikes, delivered at a constant rate over
+    ``paddle_strike_duration``: the ball's momentum changes by exactly J. Action -1 lets the ball
+    pass unstruck (it may still be struck later in the same flight).
 
     ## Observation Space
     ``Box(low, high, (5 N + 8,), float32)`` (``+3`` in paddle mode), N nodes (32 for the "fast"
@@ -96,7 +99,7 @@ class InflatedBallEnv(Env[NDArray[np.float32], NDArray[np.float32]], EzPickle):
     (10 s at 100 Hz).
 
     ## Arguments
-    ``gym.make("InflatedBall-v1", **kwargs)`` (or ``"ballenv:InflatedBall-v1"``, which also works in
+    ``gym.make("InflatedBall-v2", **kwargs)`` (or ``"ballenv:InflatedBall-v2"``, which also works in
     spawned subprocesses).
 
     | Parameter                   | Type  | Default        | Description |
@@ -112,6 +115,7 @@ class InflatedBallEnv(Env[NDArray[np.float32], NDArray[np.float32]], EzPickle):
     | paddle_max_impulse          | float | 0.15           | impulse of action +1 (N s) |
     | paddle_reach                | float | 0.4            | paddle strikes when the ball's top is this close (m) |
     | paddle_depth                | float | 0.06           | it touches the nodes this close to the top (m) |
+    | paddle_strike_duration      | float | 3e-3           | a strike delivers its impulse over this time, in (0, 1 / control_frequency] (s) |
     | radius                      | float | 0.12           | unstretched ring radius R (m) |
     | youngs_modulus              | float | 10e6           | wall modulus E (Pa) |
     | thickness                   | float | 2e-3           | wall thickness h (m) |
@@ -128,6 +132,11 @@ class InflatedBallEnv(Env[NDArray[np.float32], NDArray[np.float32]], EzPickle):
     | render_mode                 | str   | None           | "human" or "rgb_array"; one frame per control step, ``metadata["render_fps"]`` = control_frequency (real time) |
 
     ## Version History
+    - v2: smooth actuation (same task, observation and reward; different dynamics): the gas amount
+      moves to the new setpoint as a linear ramp over the control step instead of a jump at its
+      start, and a paddle strike delivers its impulse at a constant rate over
+      ``paddle_strike_duration`` (new keyword, default 3 ms) instead of at once; both are stepped by
+      the simulator (``ballenv/physics/drive.py``). v1 is no longer registered.
     - v1: numerics of the simulator changed (same physics, different numbers): the fidelity presets
       use generalized-alpha with ``rho_infinity = 0.3`` (was 0.9), and the pressure and paddle
       actions keep the integrator's carried acceleration instead of restarting it; random-action
@@ -148,7 +157,7 @@ class InflatedBallEnv(Env[NDArray[np.float32], NDArray[np.float32]], EzPickle):
         self.config = BallEnvConfig.from_kwargs(kwargs)
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(
-                f"InflatedBall-v1.render_mode = {render_mode!r} is out of range: must be None, "
+                f"InflatedBall-v2.render_mode = {render_mode!r} is out of range: must be None, "
                 "'human' or 'rgb_array'"
             )
         self.render_mode = render_mode
@@ -235,6 +244,6 @@ def ball_env(env: gym.Env[Any, Any]) -> InflatedBallEnv:
     ball = env.unwrapped
     if not isinstance(ball, InflatedBallEnv):
         raise TypeError(
-            f"{env} is not an InflatedBall env: InflatedBall-v1 (or InflatedBallPaddle-v1) expected"
+            f"{env} is not an InflatedBall env: InflatedBall-v2 (or InflatedBallPaddle-v2) expected"
         )
     return ball

@@ -1,4 +1,4 @@
-"""The observation vector of InflatedBall-v1, declared once.
+"""The observation vector of InflatedBall-v2, declared once.
 
 :data:`FIELDS` lists the entries of every observation in order, :data:`PADDLE_FIELDS` those that
 paddle mode appends. Everything else is derived from these two tables: the length of the vector

@@ -101,6 +101,20 @@ def coefficients(solver, h):
     return c_mass, c_x, c_v, solver.alpha_m
 
 
+@kernel(inline="always")
+def time_tolerance(solver):
+    """Times (s) closer than this are the same time to the step control (``1e-9 dt``)."""
+    return 1e-9 * solver.dt
+
+
+@kernel
+def force_time(solver, stop, h):
+    """The time (s) at which a step of size ``h`` ending at ``stop`` evaluates its forces, where a
+    load that changes in time is taken: the step's end for backward Euler, ``t_{n+1-alpha_f} = stop -
+    alpha_f h`` for generalized-alpha."""
+    return stop - solver.alpha_f * h
+
+
 @kernel
 def arrival_factor(solver):
     """Reaction impulse per unit momentum that stops a node arriving at a ground: 1 for backward

@@ -144,3 +144,28 @@ EVENT_KIND = EVENT.index("kind")
 EVENT_HEIGHT = EVENT.index("height")
 EVENT_KINDS = ("touchdown", "liftoff", "apex")
 EVENT_TOUCHDOWN, EVENT_LIFTOFF, EVENT_APEX = range(len(EVENT_KINDS))
+
+# columns of Drive.ramp, a ring's gas ramp (drive.py): the gas amount (Pa m^(2k)) moves linearly in
+# time from amount_start at t_start to amount_end at t_end (s); rest_ (J) and slope_ (J per
+# Pa m^(2k)) are the rest energy (Model.rest_energy) at those amounts and its derivative in the
+# amount, which interpolate it in between. Off (no ramp, the ring holds amount_end): t_end = -inf.
+RAMP = Layout(
+    "t_start", "t_end", "amount_start", "amount_end", "rest_start", "rest_end", "slope_start", "slope_end"
+)
+RAMP_T_START = RAMP.index("t_start")
+RAMP_T_END = RAMP.index("t_end")
+RAMP_AMOUNT_START = RAMP.index("amount_start")
+RAMP_AMOUNT_END = RAMP.index("amount_end")
+RAMP_REST_START = RAMP.index("rest_start")
+RAMP_REST_END = RAMP.index("rest_end")
+RAMP_SLOPE_START = RAMP.index("slope_start")
+RAMP_SLOPE_END = RAMP.index("slope_end")
+
+# columns of Drive.push, a ring's spread impulse (drive.py): momentum (x, y) (N s) delivered at a
+# constant rate over [t_start, t_end] (s), of which the fraction `delivered` so far. Off: t_end = -inf.
+PUSH = Layout("t_start", "t_end", "x", "y", "delivered")
+PUSH_T_START = PUSH.index("t_start")
+PUSH_T_END = PUSH.index("t_end")
+PUSH_X = PUSH.index("x")
+PUSH_Y = PUSH.index("y")
+PUSH_DELIVERED = PUSH.index("delivered")

@@ -26,7 +26,15 @@ from .collision import CONTACT_COLUMNS, CONTACTS_PER_NODE
 from .effects import EFFECTS
 from .effects.damping import DAMPING_CENTRE_OF_MASS, DAMPING_NONE, DAMPING_RIGID
 from .ground_motion import ground_array, grounds_move, surface_array
-from .layout import ENERGY, EVENT, TALLY
+from .layout import (
+    ENERGY,
+    EVENT,
+    PUSH,
+    PUSH_T_END,
+    RAMP,
+    RAMP_T_END,
+    TALLY,
+)
 from .linalg import BAND_COLUMNS, MAX_LOW_RANK, SOLVE_COLUMNS, zigzag_positions
 
 CONTACT_NONE = 0
@@ -61,6 +69,18 @@ class Model(NamedTuple):
     reject_self_intersection: bool  # reject trial states in which a ring crosses itself
     self_barrier: bool  # the self-contact barrier of far wall parts (barrier.py)
     effect_parameters: np.ndarray  # (R,) records: one field per effect summed, its own parameters
+
+
+class Drive(NamedTuple):
+    """Actuation spread over time (``drive.py``), per ring: a gas ramp and a spread impulse.
+
+    ``stepper.advance`` takes it as its own argument: None unless something asks for it
+    (``Simulation`` on the first ramp or spread impulse, the env always), and then the step
+    compiles none of its code, as with the self-contact barrier."""
+
+    ramp: np.ndarray  # (R, RAMP.size): the gas ramp (layout.RAMP)
+    push: np.ndarray  # (R, PUSH.size): the spread impulse (layout.PUSH)
+    pushed: np.ndarray  # (R, N) bool: the nodes sharing the spread impulse
 
 
 # Model fields with one entry per ring (the rest are scene-wide): a view of rings [a, b) slices these
@@ -244,6 +264,16 @@ def effect_parameters(scene, effects=EFFECTS):
     return table
 
 
+def build_drive(n_rings, n_nodes):
+    """A :class:`Drive` for ``n_rings`` rings of ``n_nodes`` nodes, all off; each ring's gas must be
+    held (``actuation.hold_gas``) before a ramp starts from it."""
+    ramp = np.zeros((n_rings, RAMP.size))
+    ramp[:, RAMP_T_END] = -np.inf
+    push = np.zeros((n_rings, PUSH.size))
+    push[:, PUSH_T_END] = -np.inf
+    return Drive(ramp=ramp, push=push, pushed=np.zeros((n_rings, n_nodes), dtype=np.bool_))
+
+
 def build_workspace(n_nodes, n_rings=1, effects=EFFECTS, barrier=True, ring_pairs=True, n_grounds=1):
     """Scratch arrays for one ring's Newton solve and the scene's collision detection, allocated
     once per simulation (``effects``: the model's, for the size of the energy table). ``barrier``:
@@ -353,9 +383,10 @@ def empty_recording(capacity, n_rings, n_nodes, event_capacity):
 
 
 def rings_view(record, start, stop):
-    """``record`` (a :class:`Model` or :class:`State`) restricted to rings ``[start, stop)``: views of
-    its per-ring fields (``PER_RING_FIELDS`` of a Model, every field of a State), the rest shared.
-    Compiled from the field lists, so a field added to a record is sliced or shared by name."""
+    """``record`` (a :class:`Model`, :class:`State` or :class:`Drive`) restricted to rings
+    ``[start, stop)``: views of its per-ring fields (``PER_RING_FIELDS`` of a Model, every field of a
+    State or Drive), the rest shared. Compiled from the field lists, so a field added to a record is
+    sliced or shared by name."""
 
 
 def _per_ring_fields(cls):
@@ -364,7 +395,7 @@ def _per_ring_fields(cls):
 
 @overload(rings_view)
 def _rings_view(record, start, stop):
-    if not isinstance(record, types.BaseNamedTuple) or record.instance_class not in (Model, State):
+    if not isinstance(record, types.BaseNamedTuple) or record.instance_class not in (Model, State, Drive):
         return None
     cls = record.instance_class
     sliced = _per_ring_fields(cls)

@@ -23,7 +23,13 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import ring as ring_geometry
-from .actuation import apply_impulse, set_rest_pressure
+from .actuation import (
+    apply_impulse,
+    hold_gas,
+    ramp_rest_pressure,
+    set_rest_pressure,
+    spread_impulse,
+)
 from .assembly import ENERGY_PARTS, ring_energy
 from .collision import find_contacts, self_intersects
 from .effects import EFFECTS, scene_effects
@@ -62,10 +68,12 @@ from .layout import (
     STATUS_STEP_TOO_SMALL,
 )
 from .model import (
+    Drive,
     Model,
     Recording,
     Workspace,
     build_barrier_workspace,
+    build_drive,
     build_model,
     build_workspace,
     empty_recording,
@@ -282,6 +290,9 @@ class Simulation:
         record(self.model, 0, 0.0, self.state, self.rec)
         self.counters[COUNT_RECORDS] = 1
         self.failure: str | None = None
+        self.drive: Drive | None = None  # actuation spread over time (drive.py), made on first use
+        # gauge pressure at rest (Pa) of each ring's gas amount, until a ramp takes it over (Drive.ramp)
+        self._rest_pressures = np.array([r.pressure or 0.0 for r in scene.rings])
         self._wall = time.perf_counter() - start  # s: building, then advancing
 
     @property
@@ -317,7 +328,7 @@ class Simulation:
         while True:
             status = advance(
                 self.model, self.solver, self.ws, self.state, self.trial, self.clock, self.counters,
-                target, t_end, 0.0 if self.output_dt is None else self.output_dt, self.rec,
+                target, t_end, 0.0 if self.output_dt is None else self.output_dt, self.rec, self.drive,
             )  # fmt: skip
             if status != STATUS_BUFFER_FULL:
                 return status
@@ -362,22 +373,38 @@ class Simulation:
             )
         return int(ring)
 
-    def set_rest_pressure(self, ring: int, pressure: float) -> None:
+    def set_rest_pressure(self, ring: int, pressure: float, duration: float = 0.0) -> None:
         """Set ring ``ring``'s gas to the amount whose gauge pressure at rest is ``pressure`` (Pa)
         (:func:`actuation.set_rest_pressure`), in the range ``Ring.pressure`` and the scene's atmosphere
-        allow (:func:`scene.check_gauge_pressure`); the ring must hold gas."""
+        allow (:func:`scene.check_gauge_pressure`); the ring must hold gas. ``duration`` (s): 0 sets
+        it at once; longer moves the amount linearly in time from the present one to it over
+        ``[t, t + duration]`` (a gas ramp, :mod:`.drive`: each step holds the amount of its
+        force-evaluation time, steps land on the ramp's end, where the amount is the new one
+        exactly), replacing a ramp under way."""
         owner = "Simulation.set_rest_pressure"
         ring = self._ring_index(owner, ring)
         spec = self.scene.rings[ring]
         if spec.pressure is None:
             raise ValueError(f"{owner}: ring {ring} holds no gas (Ring.pressure None)")
         pressure = check_gauge_pressure(owner, "pressure", pressure, spec, self.scene.atmospheric_pressure)
+        duration = check_real(owner, "duration", duration, 0.0, 1e6, "s")
+        if duration > 0.0:
+            ramp_rest_pressure(self.model, self._driven(), ring, pressure, self.t, self.t + duration, self.ws)
+            return
         s = self.state
         set_rest_pressure(self.model, ring, pressure, s.x[ring], s.v[ring], s.energy[ring], self.ws)
+        self._rest_pressures[ring] = pressure
+        if self.drive is not None:
+            hold_gas(self.model, self.drive, ring, pressure, self.scene.rings[0].n_nodes)
 
-    def apply_impulse(self, ring: int, nodes: ArrayLike, impulse: tuple[float, float]) -> None:
+    def apply_impulse(
+        self, ring: int, nodes: ArrayLike, impulse: tuple[float, float], duration: float = 0.0
+    ) -> None:
         """Add momentum ``impulse`` (N s, a pair, each at most 1e3 N s) to ring ``ring``, shared
-        equally by ``nodes`` (distinct node indices of the ring)."""
+        equally by ``nodes`` (distinct node indices of the ring). ``duration`` (s): 0 adds it at
+        once; longer delivers it at a constant rate over ``[t, t + duration]`` (a spread impulse,
+        :mod:`.drive`: exactly ``impulse`` whatever the steps, the last one landing on the window's
+        end), replacing a spread impulse of the ring under way."""
         owner = "Simulation.apply_impulse"
         ring = self._ring_index(owner, ring)
         n_nodes = self.scene.rings[0].n_nodes
@@ -392,11 +419,25 @@ class Simulation:
                 f"{owner}.nodes = {nodes!r} is invalid: must be distinct integers in [0, {n_nodes - 1}]"
             )
         jx, jy = check_vector(owner, "impulse", impulse, 1e3, "N s")
+        duration = check_real(owner, "duration", duration, 0.0, 1e6, "s")
         nodes = chosen.astype(np.int64)
+        if duration > 0.0:
+            spread_impulse(self._driven(), ring, nodes, len(nodes), jx, jy, self.t, self.t + duration)
+            return
         s = self.state
         apply_impulse(
             self.model, ring, s.x[ring], s.v[ring], s.energy[ring], self.ws, nodes, len(nodes), jx, jy
         )
+
+    def _driven(self) -> Drive:
+        """The run's :class:`model.Drive`, made on first use (the step then compiles its code; a run
+        that never asks for it has ``drive`` None and compiles none)."""
+        if self.drive is None:
+            n_nodes = self.scene.rings[0].n_nodes
+            self.drive = build_drive(len(self.scene.rings), n_nodes)
+            for ring, pressure in enumerate(self._rest_pressures):
+                hold_gas(self.model, self.drive, ring, float(pressure), n_nodes)
+        return self.drive
 
     def stats(self) -> SimulationStats:
         """:class:`SimulationStats` so far."""

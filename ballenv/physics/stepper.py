@@ -1,11 +1,13 @@
 """The time step of a scene: one trial step of every ring, its acceptance, and the step size.
 
 :func:`advance` repeats :func:`try_step` until a time, in phases: the step's end (:func:`step_end`:
-the step size, output times and the fixed grid), the trial step of every ring (collision impulses,
-Newton's iteration with the contact set, :mod:`.newton`), the acceptance tests (Newton failure,
-self-intersection, energy budget, ring intrusion, contact impulse), then the bookkeeping of a
-rejected (:func:`step_outcome`) or an accepted step (:func:`accept`, events, records) and the next step
-size. Counters, clock and energy columns are the named layouts of :mod:`.layout`.
+the step size, output times, the fixed grid and actuation windows), the actuation the step delivers
+(:mod:`.drive`: its share of a gas ramp or a spread impulse; nothing without them), the trial step
+of every ring (collision impulses, Newton's iteration with the contact set, :mod:`.newton`), the
+acceptance tests (Newton failure, self-intersection, energy budget, ring intrusion, contact
+impulse), then the bookkeeping of a rejected (:func:`step_outcome`) or an accepted step
+(:func:`accept`, the end of a gas ramp, events, records) and the next step size. Counters, clock
+and energy columns are the named layouts of :mod:`.layout`.
 """
 
 import math
@@ -13,11 +15,12 @@ import math
 from .assembly import ring_force
 from .collision import collision_impulses, collision_step_limit, rings_intrude, self_intersects
 from .contact import FREE
+from .drive import drive_landing, drive_step
 from .effects.gas import ring_pressure
 from .energy import boundary_work, free_energy, within_energy_budget
 from .events import detect_events
 from .ground_motion import ground_surfaces
-from .integrator import arrival_factor, carries_acceleration
+from .integrator import arrival_factor, carries_acceleration, time_tolerance
 from .jit import copy_into, kernel
 from .layout import (
     CLOCK_BOUNDARY_WORK,
@@ -258,13 +261,14 @@ def copy_state(state, trial):
 
 
 @kernel(inline="always")
-def step_end(solver, clock, counters, t_end, output_dt):
+def step_end(solver, clock, counters, t_end, output_dt, landing):
     """The end of the next step: ``(stop, at_end, at_out, at_grid)``: the time (s) the step from
     ``clock[CLOCK_T]`` with size ``clock[CLOCK_H]`` stops at, shortened to land on the next output
-    time (``output_dt`` > 0), the fixed grid (not adaptive) and ``t_end``, and which it landed on."""
+    time (``output_dt`` > 0), the fixed grid (not adaptive), an actuation's ``landing`` time (s; inf
+    for none: :func:`drive.drive_landing`) and ``t_end``, and which it landed on."""
     t = clock[CLOCK_T]
-    eps = 1e-9 * solver.dt
-    stop = t + clock[CLOCK_H]
+    eps = time_tolerance(solver)
+    stop = min(t + clock[CLOCK_H], landing)
     next_out = t_end
     if output_dt > 0.0:
         next_out = (math.floor((t + eps) / output_dt) + 1.0) * output_dt
@@ -333,7 +337,7 @@ def accept(model, solver, ws, state, trial, clock, counters, h, stop, at_grid, r
 
 
 @kernel
-def advance(model, solver, ws, state, trial, clock, counters, t_pause, t_end, output_dt, rec):
+def advance(model, solver, ws, state, trial, clock, counters, t_pause, t_end, output_dt, rec, drive):
     """Step ``state`` from ``clock[CLOCK_T]`` to ``t_end``, pausing (returning) after the first step
     that reaches ``t_pause`` (<= ``t_end``; for progress reports).
 
@@ -344,6 +348,10 @@ def advance(model, solver, ws, state, trial, clock, counters, t_pause, t_end, ou
     halved the step below ``dt_min``; ``counters[COUNT_REJECTION]`` says why the last one was) or
     STATUS_IMPULSE_AT_DT_MIN (the contact impulse exceeds ``impulse_tol`` even at ``dt_min``); on
     failure the state is the last accepted one.
+
+    ``drive``: actuation spread over time (a ``model.Drive``: gas ramps, spread impulses; each
+    step lands on their windows' ends and first takes its share, :mod:`.drive`), or None: numba
+    then prunes those calls and compiles none of their code.
 
     Step control: a rejected step (see :func:`try_step`) is retried with half the step, adaptive or
     not. With ring
@@ -363,7 +371,12 @@ def advance(model, solver, ws, state, trial, clock, counters, t_pause, t_end, ou
         if model.collide:
             limit = collision_step_limit(state.x, state.v, model.thickness, clock[CLOCK_H], ws.ring_pairs)
             clock[CLOCK_H] = max(min(clock[CLOCK_H], limit), solver.dt_min)
-        stop, at_end, at_out, at_grid = step_end(solver, clock, counters, t_end, output_dt)
+        landing = math.inf
+        if drive is not None:  # (pruned by numba for a drive of None: no code)
+            landing = drive_landing(solver, clock[CLOCK_T], drive)
+        stop, at_end, at_out, at_grid = step_end(solver, clock, counters, t_end, output_dt, landing)
+        if drive is not None:
+            drive_step(model, solver, state, clock[CLOCK_T], stop, ws, drive)
         h = stop - clock[CLOCK_T]
         its, impulse_ratio, error = try_step(model, solver, state, trial, clock[CLOCK_T], h, ws)
         error_factor = math.inf if error == 0.0 else error ** -error_exponent(solver)
@@ -374,6 +387,8 @@ def advance(model, solver, ws, state, trial, clock, counters, t_pause, t_end, ou
         if status != STATUS_DONE:
             return status
         accept(model, solver, ws, state, trial, clock, counters, h, stop, at_grid, ratio, rec)
+        if drive is not None:
+            drive_step(model, solver, state, stop, stop, ws, drive)  # a ramp ending here: its end amount
         if output_dt == 0.0 or at_out or at_end:
             record(model, counters[COUNT_RECORDS], stop, state, rec)
             counters[COUNT_RECORDS] += 1

@@ -1,5 +1,6 @@
-"""The env's reward (``ballenv.envs.batch``): the documented tolerance of the predicted apex, bounded,
-and never a gain from ending an episode early."""
+"""The env's batch (``ballenv.envs.batch``): the reward (the documented tolerance of the predicted
+apex, bounded, never a gain from ending an episode early) and the actuation spread over the control
+step (the pump's gas ramp, the paddle's spread strike)."""
 
 import math
 
@@ -9,7 +10,11 @@ import pytest
 
 import ballenv  # noqa: F401  (registers the env)
 from ballenv.controllers import PaddleDribble, PressurePump
-from ballenv.envs.batch import ENVS_PER_LINE, REWARD_AT_MARGIN, guided_chunks, height_reward
+from ballenv.envs.batch import ENVS_PER_LINE, REWARD_AT_MARGIN, env_model, guided_chunks, height_reward
+from ballenv.envs.inflated_ball import InflatedBallEnv
+from ballenv.physics.actuation import set_gas
+from ballenv.physics.layout import CLOCK_T, PUSH_DELIVERED, PUSH_T_END, PUSH_T_START, RAMP_T_END
+from ballenv.physics.model import build_workspace
 from ballenv.physics.ring import total_mass
 
 MODES = ("pressure", "paddle")
@@ -27,7 +32,7 @@ def test_height_reward_is_deepmind_controls_gaussian_tolerance():
 
 @pytest.mark.parametrize("mode", MODES)
 def test_reward_is_in_zero_one_and_is_the_sum_of_its_terms(mode):
-    env = gym.make("InflatedBall-v1", action_mode=mode)
+    env = gym.make("InflatedBall-v2", action_mode=mode)
     env.reset(seed=4)
     env.action_space.seed(4)
     rewards = []
@@ -51,7 +56,7 @@ def test_reward_measures_the_ballistic_apex_rising_and_the_last_apex_falling():
     """Falling from rest, the reward is that of the start height (the ball's last apex, observed as
     ``last_apex``); rising after its first bounce, that of its ballistic apex ``y + vy^2 / 2g``;
     after that flight's apex, that of the apex event the env reported."""
-    env = gym.make("InflatedBall-v1")
+    env = gym.make("InflatedBall-v2")
     obs, info = env.reset(seed=2)
     s = env.unwrapped.observation_structure
     target, margin = info["target_height"], env.unwrapped.config.reward_margin
@@ -86,7 +91,7 @@ def test_reward_favours_the_paddle_strike_that_hits_the_target():
     target far better than one that ignores the loss (retention 1); the reward ranks them alike."""
     scores = {}
     for retention in (0.7, 1.0):
-        env = gym.make("InflatedBallPaddle-v1")
+        env = gym.make("InflatedBallPaddle-v2")
         config = env.unwrapped.config
         dribble = PaddleDribble(
             env.unwrapped.observation_structure, total_mass(config.ring(config.initial_pressure)),
@@ -114,7 +119,7 @@ def test_ending_early_never_pays(seed):
     until the ball rests (terminated early): its return is lower."""
 
     def episode(quit_at):
-        env = gym.make("InflatedBall-v1")
+        env = gym.make("InflatedBall-v2")
         obs, _ = env.reset(seed=seed)
         pump = PressurePump(env.unwrapped.observation_structure)
         total, steps = 0.0, 0
@@ -144,3 +149,76 @@ def test_guided_chunks_cover_every_env_once_shrinking_and_line_aligned(n_envs, t
     assert (np.asarray(bounds[:-1])[big] % ENVS_PER_LINE == 0).all()  # big chunks start on a line
     if n_envs >= 2 * threads:
         assert sizes[-1] == 1
+
+
+def test_the_pump_ramps_the_gas_to_its_setpoint_by_the_end_of_each_control_step():
+    env = InflatedBallEnv(action_mode="pressure")
+    env.reset(seed=3)
+    batch = env._batch
+    n = env.config.n_nodes
+    model = env_model(batch.model, 0)._replace(gas_constant=np.zeros(1), rest_energy=np.zeros(1))
+    ws = build_workspace(n)
+    budget, setpoint = batch.state.energy[0, 2], env.config.initial_pressure
+    for k, action in enumerate([1.0, 1.0, -1.0] + [1.0] * 5):  # 34, 38, 34, 38, ... 50, 50 kPa
+        held = batch.model.gas_constant[0]
+        _, _, terminated, _, info = env.step(np.array([action], dtype=np.float32))
+        assert not terminated
+        moved, setpoint = info["pressure_setpoint"] != setpoint, info["pressure_setpoint"]
+        # the amount of the new setpoint exactly, reached at the end of the control step
+        set_gas(model, 0, setpoint, n, ws)  # what setting it at once would give
+        assert batch.model.gas_constant[0] == model.gas_constant[0]
+        assert batch.model.rest_energy[0] == model.rest_energy[0]
+        assert (batch.model.gas_constant[0] != held) == moved
+        assert batch.drive.ramp[0, RAMP_T_END] == -np.inf  # the ramp is over
+        assert batch.clocks[0, CLOCK_T] == pytest.approx((k + 1) * env.dt, abs=1e-15)
+        assert (batch.state.energy[0, 2] != budget) == moved  # the pump's work was credited
+        budget = batch.state.energy[0, 2]
+    assert setpoint == env.config.pressure_range[1] and not moved  # at the top: the gas stays
+
+
+def _falling_strike(duration):
+    """A paddle env whose ball falls in the air from 1.2 m, struck (J = 0.15 N s) at its second
+    control step; returns the env, the ball's momentum (N s) before and after that step, and which
+    nodes were within ``paddle_depth`` of the top when it struck."""
+    env = InflatedBallEnv(action_mode="paddle", paddle_reach=5.0, paddle_strike_duration=duration)
+    env.reset(seed=0)
+    batch = env._batch
+    env.step(np.array([-1.0], dtype=np.float32))  # let it fall one step: a falling ball is in reach
+    x = batch.state.x[0]
+    near_top = x[:, 1] >= x[:, 1].max() - env.config.paddle_depth
+    m = batch.model.node_mass[0]
+    before = m * batch.state.v[0].sum(axis=0)
+    _, _, _, _, info = env.step(np.array([1.0], dtype=np.float32))
+    assert info["paddle_impulse"] == pytest.approx(0.15, rel=1e-15)
+    assert np.all(batch.state.active[0] == -1)  # still in the air: only gravity and the strike
+    return env, before, m * batch.state.v[0].sum(axis=0), near_top
+
+
+@pytest.mark.parametrize("duration", [1e-3, 3e-3, 1e-2])
+def test_a_paddle_strike_delivers_exactly_its_impulse_over_its_duration(duration):
+    env, before, after, near_top = _falling_strike(duration)
+    batch = env._batch
+    weight = total_mass(env.config.ring(env.config.initial_pressure)) * 9.81
+    change = after - before - np.array([0.0, -weight * env.dt])
+    np.testing.assert_allclose(change, [0.0, -0.15], rtol=0.0, atol=1e-13)
+    push = batch.drive.push[0]
+    assert push[PUSH_T_START] == pytest.approx(env.dt, abs=1e-15)
+    assert push[PUSH_T_END] == push[PUSH_T_START] + duration
+    assert push[PUSH_DELIVERED] == 1.0
+    np.testing.assert_array_equal(batch.drive.pushed[0], near_top)  # the same nodes as at once
+
+
+def test_a_spread_strike_is_a_different_motion_of_the_same_momentum():
+    short, _, short_after, _ = _falling_strike(1e-4)
+    spread, _, spread_after, _ = _falling_strike(1e-2)
+    np.testing.assert_allclose(short_after, spread_after, rtol=0.0, atol=1e-13)
+    shape = np.abs(short._batch.state.x[0] - spread._batch.state.x[0]).max()
+    assert shape > 1e-4  # m: the wall took the strike differently
+
+
+@pytest.mark.parametrize("duration", [0.0, 0.0101, float("nan"), -1e-3])
+def test_paddle_strike_duration_out_of_range_names_the_keyword_and_its_range(duration):
+    message = rf"^InflatedBall-v2\.paddle_strike_duration = {duration!r} is out of range: must be a finite "
+    message += r"number in \(0, 0\.01\] s \(at most one control step, 1 / control_frequency\)$"
+    with pytest.raises(ValueError, match=message):
+        InflatedBallEnv(action_mode="paddle", paddle_strike_duration=duration)
