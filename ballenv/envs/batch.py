@@ -536,10 +536,7 @@ class BallBatch:
         if self.threads > 1:
             self._pool = ThreadPoolExecutor(self.threads - 1, thread_name_prefix="ballenv")
             self._scratch = [(self.ws, self.nodes)] + [
-                (
-                    build_workspace(self.n_nodes, barrier=barrier, ring_pairs=False),
-                    np.zeros(self.n_nodes, dtype=np.int64),
-                )
+                (self._scratch_workspace(barrier), np.zeros(self.n_nodes, dtype=np.int64))
                 for _ in range(self.threads - 1)
             ]
             bounds = guided_chunks(n_envs, self.threads)
