@@ -408,7 +408,7 @@ def collision_impulses(x, v, h, thickness, node_mass, rings, self_contact, cw, k
     relax = min(1.0, h / RELAXATION_TIME)
     count = 0
     if rings:
-        count = ring_kicks(v, h, thickness, node_mass, relax, kicked, rw)
+        count = ring_kicks(pred, v, h, thickness, node_mass, relax, kicked, rw)
     if self_contact:
         for r in range(x.shape[0]):
             count += _self_contacts(
@@ -424,12 +424,11 @@ def collision_impulses(x, v, h, thickness, node_mass, rings, self_contact, cw, k
 
 
 @kernel
-def ring_kicks(v, h, thickness, node_mass, relax, kicked, rw):
-    """The impulses between rings on the predicted positions ``rw.predicted`` into ``kicked`` (see
+def ring_kicks(pred, v, h, thickness, node_mass, relax, kicked, rw):
+    """The impulses between rings found on the predicted positions ``pred`` (m) into ``kicked`` (see
     :func:`collision_impulses`); returns their number. Nothing (0) without ``rw``."""
     if rw is None:
         return 0
-    pred = rw.predicted
     for r in range(pred.shape[0]):
         rw.orientation[r] = orientation(pred[r])
     count = find_contacts(pred, thickness, rw)
