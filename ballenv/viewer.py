@@ -61,6 +61,7 @@ def viewer_data(traj, max_frames=2000, title=None):
         "grounds": [
             {"angle": g.angle, "height": g.height, "x": g.x, "friction": g.friction} for g in scene.grounds
         ],
+        "drums": [{"centre": list(d.centre), "radius": d.radius, "inside": d.inside} for d in scene.drums],
         "radius": [r.radius for r in scene.rings],
         "events": [[float(t), int(r), k] for t, r, k in traj.events],
         "style": STYLE.as_json(),
@@ -130,6 +131,11 @@ function draw(k){
     const s=(cx-g.x)*d[0]+(cy-g.height)*d[1]; const b=[g.x+s*d[0], g.height+s*d[1]];
     const q=[[b[0]-far*d[0],b[1]-far*d[1]],[b[0]+far*d[0],b[1]+far*d[1]],[b[0]+far*d[0]-far*n[0],b[1]+far*d[1]-far*n[1]],[b[0]-far*d[0]-far*n[0],b[1]-far*d[1]-far*n[1]]];
     ctx.fillStyle=S.ground;ctx.beginPath();q.forEach((p,i)=>{const c=px(p[0],p[1]);i?ctx.lineTo(c[0],c[1]):ctx.moveTo(c[0],c[1]);});ctx.fill();
+  }
+  for(const g of D.drums){
+    const c=px(g.centre[0],g.centre[1]);ctx.fillStyle=S.ground;ctx.beginPath();
+    if(g.inside){ctx.rect(0,0,cv.width,cv.height);}
+    ctx.arc(c[0],c[1],g.radius*scale,0,2*Math.PI);ctx.fill("evenodd");
   }
   for(let r=0;r<nR;r++){
     ctx.strokeStyle=COLORS[r%COLORS.length];ctx.lineWidth=S.line_width;ctx.beginPath();

@@ -111,6 +111,22 @@ def test_a_ball_on_a_vibrating_plate_bounces_regularly_then_doubles_its_period()
     assert np.ptp(even) < 0.02 and np.ptp(odd) < 0.02
 
 
+def test_a_ribbon_loop_in_a_rotating_drum_rolls_and_elongates_with_speed():
+    """Fast preset, the drum at rest and at Fr = Omega^2 R_d / g = 3.9: the loop rolls (its spin
+    within 30 % of ``Omega R_d / r``, an oval's tank-treading is not a rigid spin), is longer than at
+    rest (aspect ratio up by more than 0.1; measured 1.99 -> 2.26) and climbs the drum's wall in its
+    sense of turning (centre angle 0.2 ... 1.2 rad; measured 0.84)."""
+    from ballenv.scenes.library import DRUM_RADIUS, RIBBON
+
+    rest, fast = scenes.run("rotating-drum", **FAST).metrics["rows"]
+    assert rest["froude"] == 0.0 and fast["froude"] > 3.5
+    rolling = fast["drum_spin_rad_per_s"] * DRUM_RADIUS / RIBBON["radius"]
+    assert fast["ribbon_spin_rad_per_s"] == pytest.approx(rolling, rel=0.3)
+    assert abs(rest["ribbon_spin_rad_per_s"]) < 1e-6 and abs(rest["centre_angle_rad"]) < 1e-6
+    assert fast["aspect"] > rest["aspect"] + 0.1
+    assert 0.2 < fast["centre_angle_rad"] < 1.2
+
+
 def test_cli_writes_figure_video_numbers_and_trajectories(tmp_path, capsys):
     assert (
         main(["two-balls", "--out", str(tmp_path), "--fidelity", "fast", "--reduced", "--frames", "12"]) == 0

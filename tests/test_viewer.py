@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from ballenv.draw import STYLE
-from ballenv.physics import Ground, Ring, Scene, Trajectory, simulate
+from ballenv.physics import Drum, Ground, Ring, Scene, Trajectory, simulate
 from ballenv.viewer import main, select_frames, write_html
 
 CHROMIUM_FLAGS = [
@@ -106,3 +106,24 @@ def test_page_plays_in_headless_chromium(saved, tmp_path):
     ring = np.all(np.abs(pixels - [200, 60, 40]) < 30, axis=1).sum()
     ground = np.all(np.abs(pixels - [150, 150, 150]) < 8, axis=1).sum()
     assert ring > 200 and ground > 10000, (ring, ground)
+
+
+def test_page_draws_a_drum_as_ground_around_the_ring(tmp_path):
+    """A drum the ring is inside is drawn as ground everywhere outside its circle (and the frames
+    still play): the view fits the ring, so most of the picture's corners are the drum's wall."""
+    ring = Ring(radius=0.05, n_nodes=24, position=(0.0, -0.19))
+    scene = Scene(rings=[ring], drums=[Drum(radius=0.25, friction=0.5, angular_velocity=2.0)], dt=1e-3)
+    traj = simulate(scene, 0.05, output_dt=5e-3)
+    page = write_html(traj, tmp_path / "replay.html")
+    assert json.loads(page.read_text().split('type="application/json">')[1].split("</script>")[0])[
+        "drums"
+    ] == [{"centre": [0.0, 0.0], "radius": 0.25, "inside": True}]
+    shot = tmp_path / "shot.png"
+    res = run_chromium("--window-size=940,800", f"--screenshot={shot}", f"{page.as_uri()}#frame=5")
+    assert res.returncode == 0 and shot.exists(), res.stderr[-2000:]
+    from PIL import Image
+
+    pixels = np.asarray(Image.open(shot).convert("RGB")).reshape(-1, 3).astype(int)
+    ring_pixels = np.all(np.abs(pixels - [200, 60, 40]) < 30, axis=1).sum()
+    ground = np.all(np.abs(pixels - [150, 150, 150]) < 8, axis=1).sum()
+    assert ring_pixels > 100 and ground > 10000, (ring_pixels, ground)

@@ -1,11 +1,12 @@
 """The inflated-ring simulator: pure numerics (NumPy + numba), no gymnasium, no torch."""
 
 from .compile_notice import install as _install_compile_notice
-from .scene import Ground, Ring, Scene
+from .scene import Drum, Ground, Ring, Scene
 from .simulate import simulate
 from .simulation import Simulation, SimulationError, SimulationStats, Trajectory, energy
 
 __all__ = [
+    "Drum",
     "Ground",
     "Ring",
     "Scene",

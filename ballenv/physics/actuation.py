@@ -20,7 +20,7 @@ first step at a large ``omega h`` overshoots, and with random gas commands the e
 import math
 
 from .assembly import gravity_column, ring_energy, ring_force
-from .contact import FREE
+from .contact import FREE, frame
 from .effects.gas import gas_energy
 from .energy import free_energy
 from .geometry import polygon_area
@@ -119,7 +119,7 @@ def restart(model, r, x, v, a, active, energy, ws):
         ay = ws.force[i, 1] / m
         g = active[i]
         if g != FREE:
-            nx, ny = model.grounds[g, 0], model.grounds[g, 1]
+            nx, ny, _ = frame(model.grounds, g, x[i, 0], x[i, 1])
             an = ax * nx + ay * ny
             ax -= an * nx
             ay -= an * ny

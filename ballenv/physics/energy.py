@@ -20,7 +20,11 @@ from .layout import (
     ENERGY_BUDGET,
     ENERGY_FREE,
     ENERGY_TOTAL,
+    GROUND_PLANE,
+    SURFACE_KIND,
     SURFACE_OFFSET,
+    SURFACE_RADIUS,
+    SURFACE_TURN,
     SURFACE_VELOCITY,
     TALLY_BOUNDARY_WORK,
     TALLY_PROJECTED,
@@ -71,7 +75,11 @@ def boundary_work(start, end, active, reaction, friction, h):
     the second (the friction on the slip; the normal part vanishes, a constrained node moving with
     the surface along n) only dissipates. The force is the step's end force, as in backward
     Euler's energy balance (``sum_i f_i . (x1_i - x0_i)``; a node resting on the surface through
-    the step moves along n by exactly ``n . ds``). 0 on fixed grounds. The stepper adds the work of
+    the step moves along n by exactly ``n . ds``). 0 on fixed grounds. On a drum turning by
+    ``theta(t1) - theta(t0)`` (rad) over the step, the surface under a node on the circle moves by
+    ``t . ds = s R (theta(t1) - theta(t0))`` along the node's tangent (``s`` the drum's kind, -1
+    inside, +1 outside; ``R`` its radius, m) and not at all along n, so
+    ``W_i = F_i s R (theta(t1) - theta(t0))``. The stepper adds the work of
     the impulses that put arriving nodes at rest on the surface (``Workspace.arrival_work``,
     :func:`contact.rest_on_grounds`): ``sum_i m (w_n - v_n,i) w_n`` over the velocities the step's
     kinematics gave them."""
@@ -79,6 +87,10 @@ def boundary_work(start, end, active, reaction, friction, h):
     for i in range(active.shape[0]):
         g = active[i]
         if g == FREE:
+            continue
+        if end[g, SURFACE_KIND] != GROUND_PLANE:
+            turn = end[g, SURFACE_TURN] - start[g, SURFACE_TURN]
+            work += friction[i] * end[g, SURFACE_KIND] * end[g, SURFACE_RADIUS] * turn
             continue
         nx, ny = end[g, 0], end[g, 1]
         dx, dy = _surface_displacement(start, end, g, h)
@@ -176,7 +188,7 @@ def within_energy_budget(model, r, before, kick, work, trial, ws):
         after[ENERGY_BUDGET] = after[ENERGY_TOTAL]
         ws.energy_tally[TALLY_BOUNDARY_WORK] += excess
         return True
-    reset = rest_on_grounds(ws.surface, trial.active[r], trial.v[r], trial.a[r])
+    reset = rest_on_grounds(ws.surface, trial.active[r], trial.x[r], trial.v[r], trial.a[r])
     free_energy(model, r, trial.x[r], trial.v[r], ws, after)
     if model.moving_grounds:  # the surface's work putting the nodes back on it
         after[ENERGY_BUDGET] += model.node_mass[r] * reset

@@ -15,7 +15,7 @@ kind ``layout.EVENT_KINDS`` (0 = touchdown, 1 = liftoff, 2 = apex).
 
 import numpy as np
 
-from .contact import FREE, deepest_ground
+from .contact import FREE, deepest_ground, frame, surface_velocity
 from .geometry import centre_of_mass
 from .jit import kernel
 from .layout import (
@@ -27,7 +27,6 @@ from .layout import (
     EVENT_RING,
     EVENT_T,
     EVENT_TOUCHDOWN,
-    SURFACE_VELOCITY,
 )
 
 __all__ = ["EVENT_APEX", "EVENT_KINDS", "EVENT_LIFTOFF", "EVENT_TOUCHDOWN", "detect_events", "event_list"]
@@ -82,8 +81,10 @@ def detect_events(model, surface, state, trial, t, h, events, n_events):
                     if trial.active[r, i] == FREE:
                         continue
                     g, phi0 = deepest_ground(surface, state.x[r, i, 0], state.x[r, i, 1])
-                    nx, ny = surface[g, 0], surface[g, 1]
-                    wn = surface[g, SURFACE_VELOCITY] * nx + surface[g, SURFACE_VELOCITY + 1] * ny
+                    x, y = state.x[r, i, 0], state.x[r, i, 1]
+                    nx, ny, _ = frame(surface, g, x, y)
+                    wx, wy = surface_velocity(surface, g, x, y)
+                    wn = wx * nx + wy * ny
                     vn = nx * state.v[r, i, 0] + ny * state.v[r, i, 1] - wn
                     if vn < 0.0:
                         s_first = min(s_first, max(0.0, phi0 / (-vn * h)))

@@ -116,25 +116,48 @@ TALLY_COLLISION_GAIN = TALLY.index("collision_gain")
 TALLY_BOUNDARY_WORK = TALLY.index("boundary_work")
 
 # columns of Model.grounds, a ground as described: unit normal n, offset d0 (m) at t = 0,
-# friction coefficient, constant velocity u (m/s), amplitude A (m) and angular frequency
-# omega = 2 pi f (rad/s) of its oscillation along n (ground_motion.py)
-GROUND = Layout(("normal", 2), "offset", "friction", ("velocity", 2), "amplitude", "angular_frequency")
+# friction coefficient, its kind (GROUND_PLANE, or a drum: GROUND_DRUM_INSIDE / GROUND_DRUM_OUTSIDE,
+# the sign s of its distance s (|x - c| - R)), a drum's centre c (m) and radius R (m), a plane's
+# constant velocity u (m/s), amplitude A (m) and angular frequency omega = 2 pi f (rad/s) of its
+# oscillation along n, a drum's angular velocity Omega (rad/s) and spin-up time (s) (ground_motion.py)
+GROUND = Layout(
+    ("normal", 2), "offset", "friction", "kind", ("centre", 2), "radius",
+    ("velocity", 2), "amplitude", "angular_frequency", "spin", "spin_up",
+)  # fmt: skip
 GROUND_NORMAL = GROUND.index("normal")
 GROUND_OFFSET = GROUND.index("offset")
 GROUND_FRICTION = GROUND.index("friction")
+GROUND_KIND = GROUND.index("kind")
+GROUND_CENTRE = GROUND.index("centre")
+GROUND_RADIUS = GROUND.index("radius")
 GROUND_VELOCITY = GROUND.index("velocity")
 GROUND_AMPLITUDE = GROUND.index("amplitude")
 GROUND_ANGULAR_FREQUENCY = GROUND.index("angular_frequency")
+GROUND_SPIN = GROUND.index("spin")
+GROUND_SPIN_UP = GROUND.index("spin_up")
+# values of the kind column: a half-plane; a drum with the rings inside it (s = -1) or outside it (s = +1)
+GROUND_PLANE = 0.0
+GROUND_DRUM_INSIDE = -1.0
+GROUND_DRUM_OUTSIDE = 1.0
 
 # columns of Workspace.surface, a ground at one time t: unit normal n, offset d(t) (m), friction
-# coefficient (the first four as in GROUND, so the contact code reads either), surface velocity
-# w(t) (m/s) and the surface's acceleration along n (m/s^2)
-SURFACE = Layout(("normal", 2), "offset", "friction", ("velocity", 2), "normal_acceleration")
+# coefficient, kind, drum centre and radius (the first eight as in GROUND, so the contact code reads
+# either), a plane's surface velocity w(t) (m/s) and acceleration along n (m/s^2), a drum's angular
+# velocity Omega(t) (rad/s) and the angle (rad) it has turned since t = 0
+SURFACE = Layout(
+    ("normal", 2), "offset", "friction", "kind", ("centre", 2), "radius",
+    ("velocity", 2), "normal_acceleration", "spin", "turn",
+)  # fmt: skip
 SURFACE_NORMAL = SURFACE.index("normal")
 SURFACE_OFFSET = SURFACE.index("offset")
 SURFACE_FRICTION = SURFACE.index("friction")
+SURFACE_KIND = SURFACE.index("kind")
+SURFACE_CENTRE = SURFACE.index("centre")
+SURFACE_RADIUS = SURFACE.index("radius")
 SURFACE_VELOCITY = SURFACE.index("velocity")
 SURFACE_NORMAL_ACCELERATION = SURFACE.index("normal_acceleration")
+SURFACE_SPIN = SURFACE.index("spin")
+SURFACE_TURN = SURFACE.index("turn")
 
 # rows of the event buffer: t (s), ring, kind (EVENT_KINDS), centre-of-mass height (m)
 EVENT = Layout("t", "ring", "kind", "height")

@@ -22,7 +22,7 @@ its length scale. A step is accepted when the norm is at most 1; the next step i
 
 import math
 
-from .contact import FREE
+from .contact import FREE, frame
 from .integrator import METHOD_BACKWARD_EULER
 from .jit import kernel
 
@@ -45,20 +45,21 @@ def error_exponent(solver):
 
 
 @kernel
-def _without_normal(grounds, g, ex, ey):
-    """``(ex, ey)`` less its component along ground ``g``'s normal (unchanged for ``FREE``)."""
+def _without_normal(grounds, g, x, ex, ey):
+    """``(ex, ey)`` less its component along ground ``g``'s normal at the node's position ``x``
+    (unchanged for ``FREE``)."""
     if g == FREE:
         return ex, ey
-    nx, ny = grounds[g, 0], grounds[g, 1]
+    nx, ny, _ = frame(grounds, g, x[0], x[1])
     en = ex * nx + ey * ny
     return ex - en * nx, ey - en * ny
 
 
 @kernel
-def error_norm(model, solver, r, h, a0, a1, active0, active1):
+def error_norm(model, solver, r, h, x0, x1, a0, a1, active0, active1):
     """The scaled RMS local error of ring ``r``'s step of size ``h`` (s) from start and end
     accelerations ``a0``, ``a1`` (m/s^2, (N, 2); backward Euler's ``a1 = (v1 - v0) / h``) and the
-    constraining grounds at both ends: at most 1 is within tolerance."""
+    constraining grounds at both ends (nodes at ``x0``, ``x1``): at most 1 is within tolerance."""
     c = error_coefficient(solver) * h * h
     a0_weight = 0.0 if solver.method == METHOD_BACKWARD_EULER else 1.0
     scale = solver.atol + solver.rtol * model.radius[r]
@@ -67,7 +68,7 @@ def error_norm(model, solver, r, h, a0, a1, active0, active1):
     for i in range(n):
         ex = c * (a1[i, 0] - a0_weight * a0[i, 0])
         ey = c * (a1[i, 1] - a0_weight * a0[i, 1])
-        ex, ey = _without_normal(model.grounds, active0[i], ex, ey)
-        ex, ey = _without_normal(model.grounds, active1[i], ex, ey)
+        ex, ey = _without_normal(model.grounds, active0[i], x0[i], ex, ey)
+        ex, ey = _without_normal(model.grounds, active1[i], x1[i], ex, ey)
         total += ex * ex + ey * ey
     return math.sqrt(total / n) / scale

@@ -58,7 +58,7 @@ class Model(NamedTuple):
     use_gravity: bool
     damping: float  # 1/s
     damping_mode: int
-    grounds: np.ndarray  # (G, GROUND.size): normal, offset d0 (m), friction, motion (layout.GROUND)
+    grounds: np.ndarray  # (G, GROUND.size): half-planes then drums (layout.GROUND, ground_motion.py)
     moving_grounds: bool  # a ground moves (ground_motion.py): its work is credited to the energy budget
     contact_method: int
     friction_regularization: float  # m/s
@@ -147,6 +147,7 @@ class Workspace(NamedTuple):
     ve: np.ndarray  # (N, 2)
     reaction: np.ndarray  # (N,) normal ground reaction of the last solve (N)
     friction: np.ndarray  # (N,) friction force along the ground's tangent (N)
+    tangential: np.ndarray  # (N,) unconstrained residual along the ground's tangent, t . r_i (N)
     energy: np.ndarray  # (P,) energy parts (J), columns assembly.energy_parts of the model's effects
     energy_tally: np.ndarray  # (TALLY.size,) what the last trial step's energy budget saw (layout.TALLY)
     surface_start: np.ndarray  # (G, SURFACE.size) the grounds at the trial step's start (layout.SURFACE)
@@ -210,11 +211,11 @@ def build_model(scene, effects=EFFECTS):
         use_gravity=bool(np.any(gravity != 0.0)),
         damping=float(scene.damping),
         damping_mode=mode,
-        grounds=ground_array(scene.grounds),
+        grounds=ground_array(scene.grounds, scene.drums),
         moving_grounds=grounds_move(scene),
         contact_method=(
             CONTACT_NONE
-            if not scene.grounds
+            if not (scene.grounds or scene.drums)
             else CONTACT_MASS_MODIFICATION
             if scene.contact == "mass_modification"
             else CONTACT_PREDICTOR_CORRECTOR
@@ -300,6 +301,7 @@ def build_workspace(n_nodes, n_rings=1, effects=EFFECTS, barrier=True, ring_pair
         ve=np.zeros((n_nodes, 2)),
         reaction=np.zeros(n_nodes),
         friction=np.zeros(n_nodes),
+        tangential=np.zeros(n_nodes),
         energy=np.zeros(len(energy_parts(effects))),
         energy_tally=np.zeros(TALLY.size),
         surface_start=surface_array(n_grounds),

@@ -81,7 +81,7 @@ def residual(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active):
     if model.contact_method != CONTACT_NONE:
         constrain_residual(
             ws.surface, active, x1, ws.ve, res, m, c_mass, model.friction_regularization,
-            ws.reaction, ws.friction,
+            ws.reaction, ws.friction, ws.tangential,
         )  # fmt: skip
     merit = 0.0
     worst = 0.0
@@ -92,8 +92,8 @@ def residual(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active):
 
 
 @kernel(inline="always")
-def correction(model, solver, r, x0, h, ws, active):
-    """Solve the Newton system at the iterate and apply the correction to ``ws.dx`` (kept in
+def correction(model, solver, r, x0, x1, h, ws, active):
+    """Solve the Newton system at the iterate ``x1`` and apply the correction to ``ws.dx`` (kept in
     ``ws.delta`` for backtracking). Returns ``(ok, settled)``: ok False on a singular system or a
     non-finite correction; settled when the correction is at round-off level."""
     n = x0.shape[0]
@@ -105,11 +105,11 @@ def correction(model, solver, r, x0, h, ws, active):
         wide = add_barrier_jacobian(model, r, c_x, ws, rank, ws.barrier)
     if model.contact_method != CONTACT_NONE:
         constrain_jacobian(
-            ws.surface, active, ws.ve, ws.reaction, ws.band, ws.pos, ws.u, rank, m, c_mass,
-            c_v, model.friction_regularization,
+            ws.surface, active, x1, ws.ve, ws.reaction, ws.tangential, ws.band, ws.pos, ws.u, rank, m,
+            c_mass, c_v, model.friction_regularization,
         )  # fmt: skip
         if wide > rank:
-            constrain_barrier_rows(model, active, ws, rank, wide, ws.barrier)
+            constrain_barrier_rows(model, active, x1, ws, rank, wide, ws.barrier)
     res = ws.res
     if wide == rank:
         solved = solve_band_low_rank(ws.band, ws.pos, ws.u, ws.w, rank, res, ws.work, ws.cap, ws.coef)
@@ -159,11 +159,11 @@ def add_barrier_jacobian(model, r, c_x, ws, rank, bw):
 
 
 @kernel
-def constrain_barrier_rows(model, active, ws, rank, wide, bw):
+def constrain_barrier_rows(model, active, x1, ws, rank, wide, bw):
     """The ground constraints on the barrier's low-rank columns ``rank ... wide - 1``."""
     if bw is None:
         return
-    constrain_low_rank_rows(ws.surface, active, ws.ve, bw.u, rank, wide, model.friction_regularization)
+    constrain_low_rank_rows(ws.surface, active, x1, ws.ve, bw.u, rank, wide, model.friction_regularization)
 
 
 @kernel
@@ -348,7 +348,7 @@ def newton_iterate(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active):
             if not contact:
                 return total
             if not update_contact_set(ws.surface, active, x1, ws.reaction):
-                arrival = rest_on_grounds(ws.surface, active, v1, a1)
+                arrival = rest_on_grounds(ws.surface, active, x1, v1, a1)
                 ws.arrival_work[0] = model.node_mass[r] * arrival
                 return total
             set_changes += 1
@@ -364,7 +364,7 @@ def newton_iterate(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active):
             continue  # the residual's rows changed with the set
         if it >= solver.newton_max_iter:
             return FAILED
-        ok, settled = correction(model, solver, r, x0, h, ws, active)
+        ok, settled = correction(model, solver, r, x0, x1, h, ws, active)
         if not ok:
             return FAILED
         total += 1

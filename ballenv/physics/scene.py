@@ -232,12 +232,59 @@ class Ground:
 
 
 @dataclass(frozen=True)
+class Drum:
+    """A circular ground (a drum): the rings inside it or outside it, turning about its centre.
+
+    The rings stay in ``R - |x - c| >= 0`` (``inside``) or ``|x - c| - R >= 0`` (outside: a round
+    obstacle). The drum turns about its fixed centre ``c`` at the angular velocity (rad/s,
+    counter-clockwise positive) ``Omega(t) = Omega_0 min(1, t / T)`` after a spin-up over ``T`` s
+    (``ballenv.physics.ground_motion``), so its surface at ``x`` moves with
+    ``w = Omega e_z x (x - c)``, along the surface. A node in contact ends each step on the circle;
+    Coulomb friction acts on its velocity relative to ``w``, and the work the turning drum does
+    through it is credited to the energy budget (``energy.boundary_work``).
+
+    Attributes:
+        radius: radius R (m) of the circle, in (0, 1e6].
+        centre: its centre c (m), each component in [-1e6, 1e6].
+        inside: True (default): the rings are inside the drum; False: outside it.
+        friction: Coulomb coefficient mu in [0, 10] (0: frictionless).
+        angular_velocity: Omega_0 (rad/s) in [-1e4, 1e4]; 0: a fixed drum.
+        spin_up: T (s) in [0, 1e6] over which Omega grows linearly from 0 to Omega_0; 0: none.
+    """
+
+    radius: float = 1.0
+    centre: tuple[float, float] = (0.0, 0.0)
+    inside: bool = True
+    friction: float = 0.0
+    angular_velocity: float = 0.0
+    spin_up: float = 0.0
+
+    def __post_init__(self) -> None:
+        o = "Drum"
+        s = object.__setattr__
+        s(self, "radius", check_real(o, "radius", self.radius, 0.0, 1e6, "m", low_open=True))
+        s(self, "centre", check_vector(o, "centre", self.centre, 1e6, "m"))
+        if not isinstance(self.inside, bool):
+            _fail(o, "inside", self.inside, "True or False")
+        s(self, "friction", check_real(o, "friction", self.friction, 0.0, 10.0))
+        spin = check_real(o, "angular_velocity", self.angular_velocity, -1e4, 1e4, "rad/s")
+        s(self, "angular_velocity", spin)
+        s(self, "spin_up", check_real(o, "spin_up", self.spin_up, 0.0, 1e6, "s"))
+
+    @property
+    def moves(self) -> bool:
+        """The drum turns."""
+        return self.angular_velocity != 0.0
+
+
+@dataclass(frozen=True)
 class Scene:
     """What to simulate: rings, the effects acting on them, and the numerical method.
 
     Attributes:
         rings: one or more :class:`Ring` (all with the same ``n_nodes``).
-        grounds: any number of :class:`Ground` half-planes (none: no contact work at all).
+        grounds: any number of :class:`Ground` half-planes (none, and no drums: no contact work at all).
+        drums: any number of :class:`Drum` circular grounds, the rings inside or outside them.
         contact: "mass_modification" (Baraff-Witkin: the contact set is updated inside the Newton
             iteration; the system keeps its size) or "predictor_corrector" (the paper's first
             method: the whole step is recomputed after each change of the contact set).
@@ -293,6 +340,7 @@ class Scene:
 
     rings: Sequence[Ring] = field(default_factory=lambda: (Ring(),))
     grounds: Sequence[Ground] = ()
+    drums: Sequence[Drum] = ()
     contact: str = "mass_modification"
     impulse_tol: float = 5e-3
     rtol: float = 0.0
@@ -321,6 +369,7 @@ class Scene:
             _fail(o, "rings", [r.n_nodes for r in rings], "rings with equal n_nodes")
         s(self, "rings", rings)
         s(self, "grounds", check_sequence(o, "grounds", self.grounds, Ground, allow_empty=True))
+        s(self, "drums", check_sequence(o, "drums", self.drums, Drum, allow_empty=True))
         s(self, "contact", check_choice(o, "contact", self.contact, CONTACT_METHODS))
         s(self, "impulse_tol", check_real(o, "impulse_tol", self.impulse_tol, 0.0, 10.0, "N s", True))
         s(self, "rtol", check_real(o, "rtol", self.rtol, 0.0, 1.0))

@@ -58,6 +58,11 @@ from .layout import (
     EVENT_KIND,
     EVENT_RING,
     EVENT_T,
+    GROUND_CENTRE,
+    GROUND_DRUM_INSIDE,
+    GROUND_KIND,
+    GROUND_PLANE,
+    GROUND_RADIUS,
     N_CLOCK,
     N_COUNTERS,
     REJECTION_REASONS,
@@ -268,7 +273,7 @@ class Simulation:
             effects,
             barrier=self.model.self_barrier,
             ring_pairs=self.model.collide,
-            n_grounds=len(scene.grounds),
+            n_grounds=len(scene.grounds) + len(scene.drums),
         )
         self.state = empty_state(n_rings, n_nodes)
         self.trial = empty_state(n_rings, n_nodes)
@@ -542,14 +547,21 @@ def _grown(rec: Recording, counters: NDArray[np.int64]) -> Recording:
 
 
 def _check_above_grounds(caller: str, grounds: NDArray[np.float64], x: NDArray[np.float64]) -> None:
-    for g, (nx, ny, d) in enumerate(grounds[:, :3]):  # d = d(0)
-        phi = x[..., 0] * nx + x[..., 1] * ny - d
+    n_planes = int(np.sum(grounds[:, GROUND_KIND] == GROUND_PLANE))
+    for g, row in enumerate(grounds):
+        side = row[GROUND_KIND]
+        if side == GROUND_PLANE:
+            nx, ny, d = row[:3]  # d = d(0)
+            phi = x[..., 0] * nx + x[..., 1] * ny - d
+            where = f"below Scene.grounds[{g}]: every node must start on or above every ground"
+        else:
+            cx, cy = row[GROUND_CENTRE : GROUND_CENTRE + 2]
+            phi = side * (np.hypot(x[..., 0] - cx, x[..., 1] - cy) - row[GROUND_RADIUS])
+            inside = "inside" if side == GROUND_DRUM_INSIDE else "outside"
+            where = f"outside Scene.drums[{g - n_planes}]: every node must start {inside} the drum"
         if np.any(phi < 0.0):
             ring, node = np.argwhere(phi < 0.0)[0]
-            raise ValueError(
-                f"{caller}: node {node} of ring {ring} starts {-phi[ring, node]:.3g} m below "
-                f"Scene.grounds[{g}]: every node must start on or above every ground"
-            )
+            raise ValueError(f"{caller}: node {node} of ring {ring} starts {-phi[ring, node]:.3g} m {where}")
 
 
 def _check_apart(caller: str, model: Model, x: NDArray[np.float64], ws: Workspace) -> None:

@@ -14,7 +14,7 @@ import math
 
 from .assembly import ring_force
 from .collision import collision_impulses, collision_step_limit, rings_intrude, self_intersects
-from .contact import FREE
+from .contact import FREE, frame, surface_velocity
 from .drive import drive_landing, drive_step
 from .effects.gas import ring_pressure
 from .energy import boundary_work, free_energy, within_energy_budget
@@ -41,6 +41,8 @@ from .layout import (
     COUNT_STEPS,
     ENERGY_BUDGET,
     ENERGY_TOTAL,
+    GROUND_KIND,
+    GROUND_PLANE,
     REJECT_ENERGY,
     REJECT_INTRUSION,
     REJECT_NEWTON,
@@ -49,7 +51,6 @@ from .layout import (
     STATUS_DONE,
     STATUS_IMPULSE_AT_DT_MIN,
     STATUS_STEP_TOO_SMALL,
-    SURFACE_VELOCITY,
     TALLY_BOUNDARY_WORK,
     TALLY_COLLISION_GAIN,
     TALLY_PROJECTED,
@@ -146,7 +147,7 @@ def contact_impulse(model, solver, r, state, v0, trial, h, ws):
             trial.contact_force[r, i, 0] = 0.0
             trial.contact_force[r, i, 1] = 0.0
             continue
-        nx, ny = model.grounds[g, 0], model.grounds[g, 1]
+        nx, ny, _ = frame(model.grounds, g, trial.x[r, i, 0], trial.x[r, i, 1])
         fn, ft = ws.reaction[i], ws.friction[i]
         fx = fn * nx - ft * ny
         fy = fn * ny + ft * nx
@@ -158,8 +159,13 @@ def contact_impulse(model, solver, r, state, v0, trial, h, ws):
         # a resting one pushed by a collision impulse): kappa m (v_n - w_n + gap / h), relative to
         # the surface at the step's start
         start = ws.surface_start
-        gap = max(0.0, nx * state.x[r, i, 0] + ny * state.x[r, i, 1] - start[g, 2])
-        wn = start[g, SURFACE_VELOCITY] * nx + start[g, SURFACE_VELOCITY + 1] * ny
+        x, y = state.x[r, i, 0], state.x[r, i, 1]
+        gap = max(0.0, nx * x + ny * y - start[g, 2])
+        if model.grounds[g, GROUND_KIND] != GROUND_PLANE:
+            _, _, gap = frame(start, g, x, y)
+            gap = max(0.0, gap)
+        wx, wy = surface_velocity(start, g, x, y)
+        wn = wx * nx + wy * ny
         vn = min(0.0, v0[r, i, 0] * nx + v0[r, i, 1] * ny - wn + gap / h)
         if vn < 0.0:
             jx += m * vn * nx
@@ -175,7 +181,9 @@ def contact_impulse(model, solver, r, state, v0, trial, h, ws):
 @kernel(inline="always")
 def ring_error(model, solver, r, state, trial, h):
     """Ring ``r``'s scaled local error (:func:`local_error.error_norm`; at most 1 is accepted)."""
-    return error_norm(model, solver, r, h, state.a[r], trial.a[r], state.active[r], trial.active[r])
+    return error_norm(
+        model, solver, r, h, state.x[r], trial.x[r], state.a[r], trial.a[r], state.active[r], trial.active[r]
+    )
 
 
 @kernel(inline="always")

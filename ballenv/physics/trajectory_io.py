@@ -16,7 +16,7 @@ key                 shape               dtype     content
 ``event_table``     (E, 4)              float64   t (s), ring, kind (0 touchdown, 1 lift-off,
                                                   2 apex), centre-of-mass height (m)
 ``scene``           ()                  str       the :class:`Scene` as JSON: its fields, with
-                                                  ``rings`` and ``grounds`` lists of field dicts
+                                                  ``rings``, ``grounds``, ``drums`` lists of field dicts
 ``stats``           ()                  str       the :class:`SimulationStats` as JSON
 ==================  ==================  ========  ===================================================
 
@@ -38,7 +38,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .events import EVENT_KINDS, event_list
-from .scene import Ground, Ring, Scene
+from .scene import Drum, Ground, Ring, Scene
 
 if TYPE_CHECKING:
     from .simulation import Trajectory
@@ -49,11 +49,11 @@ ARRAYS = ("t", "x", "v", "pressure", "contact_force", "event_table")
 
 
 def scene_to_dict(scene: Scene) -> dict[str, Any]:
-    """``scene`` as a JSON-ready dict (rings and grounds as lists of field dicts)."""
+    """``scene`` as a JSON-ready dict (rings, grounds and drums as lists of field dicts)."""
     out = {}
     for f in dataclasses.fields(scene):
         value = getattr(scene, f.name)
-        if f.name in ("rings", "grounds"):
+        if f.name in ("rings", "grounds", "drums"):
             value = [dataclasses.asdict(item) for item in value]
         elif isinstance(value, tuple):
             value = list(value)
@@ -66,9 +66,10 @@ def scene_from_dict(data: Mapping[str, Any]) -> Scene:
     data = dict(data)
     rings = [Ring(**_tupled(r)) for r in data.pop("rings")]
     grounds = [Ground(**g) for g in data.pop("grounds")]
+    drums = [Drum(**d) for d in data.pop("drums", [])]
     if isinstance(data.get("gravity"), list):
         data["gravity"] = tuple(data["gravity"])
-    return Scene(rings=rings, grounds=grounds, **data)
+    return Scene(rings=rings, grounds=grounds, drums=drums, **data)
 
 
 def _tupled(ring: Mapping[str, Any]) -> dict[str, Any]:

@@ -14,6 +14,7 @@ variable-inflation  -          gas pumped in at each apex against the same ball 
 slope-spin          -          a bounce on a slope with back-spin, none and top-spin
 two-balls           -          two balls colliding in flight (oblique, no gravity)
 vibrating-plate     -          a ball on a vibrating plate: bifurcation diagram against Gamma
+rotating-drum       -          a soft ribbon loop rolling in a rotating drum: aspect ratio vs speed
 ==================  =========  =================================================================
 
 ``run(name, fidelity="balanced", reduced=False)`` returns a :class:`SceneResult` (parameters,
@@ -54,6 +55,8 @@ SCENES = {
         SceneInfo("two-balls", "-", "two balls colliding in flight", library.two_balls),
         SceneInfo("vibrating-plate", "-", "a ball on a vibrating plate: apex heights against Gamma",
                   library.vibrating_plate),
+        SceneInfo("rotating-drum", "-", "a ribbon loop rolling in a rotating drum: aspect ratio vs speed",
+                  library.rotating_drum),
     )
 }  # fmt: skip
 

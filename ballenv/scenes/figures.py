@@ -5,6 +5,7 @@ import math
 import numpy as np
 
 from ..extras import optional_module
+from .library import least_curvature
 
 DPI = 80
 
@@ -244,6 +245,49 @@ def _vibrating_plate(plt, res):
     return fig
 
 
+def _rotating_drum(plt, res):
+    rows = res.metrics["rows"]
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4.5))
+    froude = [r["froude"] for r in rows]
+    axes[0].plot(
+        froude, [r["aspect"] for r in rows], "o-", color="k", label="aspect ratio (mean of the last 1 s)"
+    )
+    low = [r["aspect"] - r["aspect_range"][0] for r in rows]
+    high = [r["aspect_range"][1] - r["aspect"] for r in rows]
+    axes[0].errorbar(froude, [r["aspect"] for r in rows], yerr=[low, high], fmt="none", color="0.5")
+    axes[0].set_xlabel("Froude number Omega^2 R_d / g")
+    axes[0].set_ylabel("major / minor axis")
+    axes[0].set_title("ribbon loop in a rotating drum (Raux et al. 2010, qualitatively)", fontsize=10)
+    twin = axes[0].twinx()
+    twin.plot(froude, [math.degrees(r["centre_angle_rad"]) for r in rows], "s:", color="tab:blue", ms=4)
+    twin.set_ylabel("centre's angle from the bottom (deg)", color="tab:blue")
+    axes[0].legend(fontsize=8, loc="upper left")
+    drum = res.parameters["drum_radius"]
+    phi = np.linspace(0.0, 2.0 * math.pi, 400)
+    axes[1].plot(drum * np.cos(phi), drum * np.sin(phi), color="0.3", lw=1.5)
+    labels = list(res.trajectories)
+    picks = list(dict.fromkeys([labels[0], labels[len(labels) // 2], labels[-1]]))
+    for label, colour in zip(picks, ("k", "tab:green", "tab:red"), strict=False):
+        tr = res.trajectories[label]
+        k = len(tr.t) - 1
+        if label == labels[-1]:  # the fastest: its most concave shape of the last second
+            late = np.nonzero(tr.t > tr.t[-1] - 1.0 - 1e-9)[0]
+            k = int(late[np.argmin([least_curvature(tr.x[j, 0]) for j in late])])
+        axes[1].plot(
+            *_closed(tr.x[k, 0]).T, color=colour, lw=1.5, label=f"{label} rad/s, t = {tr.t[k]:.2f} s"
+        )
+    axes[1].set_aspect("equal")
+    axes[1].set_xlim(-drum * 0.4, drum * 0.8)
+    axes[1].set_ylim(-drum * 1.03, -drum * 0.35)
+    axes[1].set_xlabel("x (m)")
+    axes[1].set_ylabel("y (m)")
+    axes[1].set_title(
+        "last shapes; the fastest: its most concave (drum turning counter-clockwise)", fontsize=10
+    )
+    axes[1].legend(fontsize=8, loc="upper left")
+    return fig
+
+
 PLOTS = {
     "bounce-vs-pressure": _bounce_vs_pressure,
     "bounce-strip": _bounce_strip,
@@ -253,4 +297,5 @@ PLOTS = {
     "slope-spin": _slope_spin,
     "two-balls": _two_balls,
     "vibrating-plate": _vibrating_plate,
+    "rotating-drum": _rotating_drum,
 }
