@@ -30,6 +30,7 @@ from .layout import (
     TALLY_PROJECTED,
     TALLY_REMOVED,
 )
+from .wall_limits import wall_limit_energy
 
 ENERGY_GROWTH_TOL = 1e-2  # largest energy gain of a step, relative to the ring's free energy
 WORK_ERROR_TOL = 0.1  # largest unpayable excess of a step on a moving ground, relative to its |work|
@@ -102,16 +103,19 @@ def boundary_work(start, end, active, reaction, friction, h):
 
 @kernel
 def self_contact_energy(model, r, x, bw):
-    """The self-contact barrier's energy (J) of ring ``r`` at nodes ``x``: 0 without a pair within
-    ``dhat`` (then exactly nothing is added), or without the barrier's workspace (``bw`` None)."""
+    """The self-contact barrier's energy (J) of ring ``r`` at nodes ``x``, with its wall limits'
+    (:func:`wall_limits.wall_limit_energy`, fold and collapse): 0 without a pair within ``dhat``
+    and no node or edge near a limit (then exactly nothing is added), or without the barrier's
+    workspace (``bw`` None)."""
     if bw is None:
         return 0.0
+    limits = wall_limit_energy(x, model.rest_len[r], model.ea[r])
     if near_pairs(x, model.rest_len[r], reach(model, r), bw) == 0:
-        return 0.0  # (no sweep where the step's end was found clear)
+        return limits  # (no sweep where the step's end was found clear)
     count = find_pairs(x, x, model.rest_len[r], reach(model, r), bw)
     if count < 0:
         return math.inf
-    return barrier_energy(x, bw.pairs, count, stiffness(model, r), reach(model, r))
+    return limits + barrier_energy(x, bw.pairs, count, stiffness(model, r), reach(model, r))
 
 
 @kernel

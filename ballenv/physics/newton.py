@@ -46,6 +46,7 @@ from .integrator import coefficients, kinematics, predict
 from .jit import copy_into, kernel
 from .linalg import solve_band_low_rank, solve_band_wide_low_rank
 from .model import CONTACT_MASS_MODIFICATION, CONTACT_NONE
+from .wall_limits import limit_fraction, wall_limit_force, wall_limit_jacobian
 
 MAX_CONTACT_SET_CHANGES = 64
 PLAIN = 0  # Workspace.barrier.mode[0]: the step without the self-contact barrier
@@ -65,6 +66,7 @@ def residual(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active):
     ring_force(model, r, ws.xe, ws.ve, ws.force)
     if model.self_barrier:
         add_barrier_force(model, r, ws, ws.barrier)
+        add_limit_force(model, r, ws, ws.barrier)
     res = ws.res
     f = ws.force
     scale = 0.0
@@ -102,6 +104,7 @@ def correction(model, solver, r, x0, x1, h, ws, active):
     rank = ring_jacobian(model, r, ws.xe, ws.ve, c_mass, c_x, c_v, ws)
     wide = rank
     if model.self_barrier:
+        add_limit_jacobian(model, r, c_x, ws, ws.barrier)
         wide = add_barrier_jacobian(model, r, c_x, ws, rank, ws.barrier)
     if model.contact_method != CONTACT_NONE:
         constrain_jacobian(
@@ -122,6 +125,7 @@ def correction(model, solver, r, x0, x1, h, ws, active):
         cut = barrier_filter(model, r, c_x, ws, res, ws.barrier)
         if cut < 0.0:
             return False, False
+        cut = min(cut, limit_filter(c_x, ws.xe, x1, res, ws.barrier))
     dx = ws.dx  # (arrays taken out of the workspace once, not per element)
     delta = ws.delta
     step = 0.0
@@ -212,6 +216,42 @@ def _cut_at_impact(model, r, xa, bw):
 
 
 @kernel
+def add_limit_force(model, r, ws, bw):
+    """In either mode, add the wall limits' force (:mod:`.wall_limits`) at the force evaluation point
+    ``ws.xe`` to ``ws.force`` (nothing unless a node folds or an edge collapses that far)."""
+    if bw is None:
+        return
+    wall_limit_force(ws.xe, model.rest_len[r], model.ea[r], ws.force)
+
+
+@kernel
+def add_limit_jacobian(model, r, c_x, ws, bw):
+    """In either mode, add ``c_x`` times the wall limits' Hessian at ``ws.xe`` to the band."""
+    if bw is None:
+        return
+    wall_limit_jacobian(ws.xe, model.rest_len[r], model.ea[r], c_x, ws.band, ws.pos)
+
+
+@kernel
+def limit_filter(c_x, xe, x1, step, bw):
+    """The fraction of the correction ``-step`` (2N,) that neither folds a node through nor collapses
+    an edge (:func:`wall_limits.limit_fraction`), over the motions of the force evaluation point
+    ``xe -> xe - c_x step`` and of the step's end ``x1 -> x1 - step`` (the same motion for backward
+    Euler); 1 if neither would."""
+    if bw is None:
+        return 1.0
+    cut = 1.0
+    for k in range(2 if c_x != 1.0 else 1):
+        xa = xe if k == 0 else x1
+        scale = c_x if k == 0 else 1.0
+        for i in range(xa.shape[0]):
+            for d in range(2):
+                bw.xn[i, d] = xa[i, d] - scale * step[2 * i + d]
+        cut = min(cut, limit_fraction(xa, bw.xn))
+    return cut
+
+
+@kernel
 def add_barrier_force(model, r, ws, bw):
     """In safe mode, add the self-contact barrier's force at the force evaluation point ``ws.xe``
     (on the candidate pairs of the last correction's motion) to ``ws.force``."""
@@ -223,19 +263,25 @@ def add_barrier_force(model, r, ws, bw):
 
 @kernel
 def barrier_start(model, solver, r, x0, h, ws, bw):
-    """With the barrier: the candidate pairs over the predictor's motion (force evaluation point
-    ``x0 -> x0 + c_x dx``) and the predictor cut before its first impact. False if they do not
-    fit."""
+    """With the barrier: in safe mode, the candidate pairs over the predictor's motion (force
+    evaluation point ``x0 -> x0 + c_x dx``) and the predictor cut before its first impact; in either
+    mode, the predictor cut before it folds a node through or collapses an edge
+    (:func:`wall_limits.limit_fraction` over ``x0 -> x0 + dx``). False if the pairs do not fit."""
     if bw is None:
         return True
-    if not (model.self_barrier and bw.mode[0] == SAFE):
+    if not model.self_barrier:
         return True
     _, c_x, _, _ = coefficients(solver, h)
     dx = ws.dx
     for i in range(x0.shape[0]):
         for d in range(2):
-            bw.xn[i, d] = x0[i, d] + c_x * dx[i, d]
-    cut = _cut_at_impact(model, r, x0, bw)
+            bw.xn[i, d] = x0[i, d] + dx[i, d]  # the end's motion; the force point's is its first part
+    cut = limit_fraction(x0, bw.xn)
+    if bw.mode[0] == SAFE:
+        for i in range(x0.shape[0]):
+            for d in range(2):
+                bw.xn[i, d] = x0[i, d] + c_x * dx[i, d]
+        cut = min(cut, _cut_at_impact(model, r, x0, bw))
     if cut < 1.0:
         for i in range(x0.shape[0]):
             for d in range(2):

@@ -332,7 +332,8 @@ class Scene:
         self_intersection: "barrier" (default: "reject", and wall parts of a ring far apart
             along it repel through a barrier potential inside the implicit step, with continuous
             collision detection on the Newton iterates, so a squashed ring rests folded;
-            ``barrier.py``), "reject" (wall parts of a ring within a few edges of each other along
+            ``barrier.py``; and a node folding shut or an edge collapsing meets a barrier of its
+            own, ``wall_limits.py``), "reject" (wall parts of a ring within a few edges of each other along
             the ring push apart like two rings, and a trial state in which a ring's polygon crosses
             itself is rejected and the step retried smaller; at ``dt_min`` simulate() stops with
             SimulationError) or "ignore" (neither).
