@@ -108,6 +108,14 @@ EVENT_ROWS = 32
 ENVS_PER_LINE = 8  # envs of a float64 or int64 per-env array in one 64-byte cache line
 
 
+@kernel(inline="always")
+def env_ring():
+    """Index of an env's one ring in its model and state views (:func:`env_model`,
+    :func:`env_state`): 0, typed int64. Passed as the literal 0, the callees (restart, the energy,
+    the forces, ...) would each compile a second time, specialised on that literal."""
+    return np.int64(0)
+
+
 class Task(NamedTuple):
     """The task's settings (scalars) and per-env values (arrays of length E)."""
 
@@ -184,12 +192,13 @@ def reset_env(
     me = env_model(model, e)
     se = env_state(state, e)
     de = env_state(drive, e)
+    ring = env_ring()
     x = se.x[0]
     v = se.v[0]
     n = x.shape[0]
     radius = model.radius[e]
     if model.pressurised[e]:
-        radius = rest_circle_radius(me, 0, pressure, n)
+        radius = rest_circle_radius(me, ring, pressure, n)
     for i in range(n):
         theta = phase + 2.0 * math.pi * i / n
         x[i, 0] = centre[0] + radius * math.cos(theta)
@@ -200,10 +209,10 @@ def reset_env(
         se.contact_force[0, i, 0] = 0.0
         se.contact_force[0, i, 1] = 0.0
     if model.pressurised[e]:
-        set_gas(me, 0, pressure, n, ws)  # restart() counts the energy
-    hold_gas(me, de, 0, pressure, n)
-    stop_push(de, 0)
-    restart(me, 0, x, v, se.a[0], se.active[0], se.energy[0], ws)
+        set_gas(me, ring, pressure, n, ws)  # restart() counts the energy
+    hold_gas(me, de, ring, pressure, n)
+    stop_push(de, ring)
+    restart(me, ring, x, v, se.a[0], se.active[0], se.energy[0], ws)
     se.energy[0, ENERGY_BUDGET] = se.energy[0, ENERGY_TOTAL]  # a new episode starts a new budget
     clocks[e, :] = 0.0
     clocks[e, CLOCK_H] = solver.dt
@@ -277,9 +286,9 @@ def _actuate(me, se, de, task, e, action, t, ws, nodes):
         most = task.pressure_rate * task.control_dt
         pressure = task.setpoint[e] + min(most, max(-most, command - task.setpoint[e]))
         if pressure != task.setpoint[e]:
-            ramp_rest_pressure(me, de, 0, pressure, t, (task.steps[e] + 1) * task.control_dt, ws)
+            ramp_rest_pressure(me, de, env_ring(), pressure, t, (task.steps[e] + 1) * task.control_dt, ws)
             task.setpoint[e] = pressure
-            task.rest_radius[e] = rest_circle_radius(me, 0, pressure, n)
+            task.rest_radius[e] = rest_circle_radius(me, env_ring(), pressure, n)
         return
     impulse = 0.5 * (action + 1.0) * task.paddle_max_impulse
     if not task.in_reach[e] or impulse <= 0.0:
@@ -290,7 +299,7 @@ def _actuate(me, se, de, task, e, action, t, ws, nodes):
         if x[i, 1] >= top - task.paddle_depth:
             nodes[count] = i
             count += 1
-    spread_impulse(de, 0, nodes, count, 0.0, -impulse, t, t + task.paddle_strike_duration)
+    spread_impulse(de, env_ring(), nodes, count, 0.0, -impulse, t, t + task.paddle_strike_duration)
     task.impulse[e] = impulse
     task.struck[e] = True
 
@@ -453,7 +462,7 @@ def observe_env(model, state, task, e, row):
     centre_velocity = field_start(OBS_CENTRE_OF_MASS_VELOCITY, n)
     row[centre_velocity] = ux
     row[centre_velocity + 1] = uy
-    row[field_start(OBS_PRESSURE, n)] = ring_pressure(env_model(model, e), 0, x)
+    row[field_start(OBS_PRESSURE, n)] = ring_pressure(env_model(model, e), env_ring(), x)
     row[field_start(OBS_PRESSURE_SETPOINT, n)] = task.setpoint[e]
     row[field_start(OBS_TARGET_HEIGHT, n)] = task.target[e]
     row[field_start(OBS_LAST_APEX, n)] = task.last_apex[e]
