@@ -127,6 +127,16 @@ BALLENV_SETTINGS = [
         (f"GA adaptive dt<=1e-2 rtol={_tol(rtol)}", dict(adaptive=True, dt=1e-2, rtol=rtol))
         for rtol in (1e-1, 3e-2, 1e-2, 3e-3, 1e-3)
     ],
+    # more numerical damping of the wall modes the error control need not follow: after the bounce
+    # the light ring rings, and at rho_inf 0.9 the steps stay short until the end
+    *[
+        (
+            f"GA adaptive dt<=1e-2 rtol={_tol(rtol)}, rho_inf={rho}",
+            dict(adaptive=True, dt=1e-2, rtol=rtol, rho_infinity=rho),
+        )
+        for rtol in (3e-2, 1e-2)
+        for rho in (0.5, 0.3)
+    ],
     *[(f"preset {name} (N={p['n_nodes']})", dict(fidelity=name)) for name, p in FIDELITY_PRESETS.items()],
 ]
 QUICK_BALLENV = ("GA fixed dt=2^-11", "GA adaptive dt<=1e-3 tol=1e-4", "preset balanced (N=64)")

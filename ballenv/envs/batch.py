@@ -12,9 +12,8 @@ deliver it), and tally the apex events of the interval. Only an apex in flight c
 (after a lift-off, before the next touchdown): the centre of mass also turns round inside a squash.
 """
 
-import itertools
 import math
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Mapping
 from concurrent.futures import ThreadPoolExecutor
 from typing import TYPE_CHECKING, Any, NamedTuple
 
@@ -84,6 +83,7 @@ from .observation import (
 )
 from .observation import size as layout_size
 from .observation import structure as layout_structure
+from .tickets import draw_ticket
 
 if TYPE_CHECKING:
     from ..physics.scene import Scene
@@ -106,6 +106,14 @@ REWARD_SCALE = math.sqrt(-2.0 * math.log(REWARD_AT_MARGIN))
 NO_OUTPUT = 1e300  # output interval of advance(): record only at the end of the control step
 EVENT_ROWS = 32
 ENVS_PER_LINE = 8  # envs of a float64 or int64 per-env array in one 64-byte cache line
+
+
+@kernel(inline="always")
+def env_ring():
+    """Index of an env's one ring in its model and state views (:func:`env_model`,
+    :func:`env_state`): 0, typed int64. Passed as the literal 0, the callees (restart, the energy,
+    the forces, ...) would each compile a second time, specialised on that literal."""
+    return np.int64(0)
 
 
 class Task(NamedTuple):
@@ -184,12 +192,13 @@ def reset_env(
     me = env_model(model, e)
     se = env_state(state, e)
     de = env_state(drive, e)
+    ring = env_ring()
     x = se.x[0]
     v = se.v[0]
     n = x.shape[0]
     radius = model.radius[e]
     if model.pressurised[e]:
-        radius = rest_circle_radius(me, 0, pressure, n)
+        radius = rest_circle_radius(me, ring, pressure, n)
     for i in range(n):
         theta = phase + 2.0 * math.pi * i / n
         x[i, 0] = centre[0] + radius * math.cos(theta)
@@ -200,10 +209,10 @@ def reset_env(
         se.contact_force[0, i, 0] = 0.0
         se.contact_force[0, i, 1] = 0.0
     if model.pressurised[e]:
-        set_gas(me, 0, pressure, n, ws)  # restart() counts the energy
-    hold_gas(me, de, 0, pressure, n)
-    stop_push(de, 0)
-    restart(me, 0, x, v, se.a[0], se.active[0], se.energy[0], ws)
+        set_gas(me, ring, pressure, n, ws)  # restart() counts the energy
+    hold_gas(me, de, ring, pressure, n)
+    stop_push(de, ring)
+    restart(me, ring, x, v, se.a[0], se.active[0], se.energy[0], ws)
     se.energy[0, ENERGY_BUDGET] = se.energy[0, ENERGY_TOTAL]  # a new episode starts a new budget
     clocks[e, :] = 0.0
     clocks[e, CLOCK_H] = solver.dt
@@ -277,9 +286,9 @@ def _actuate(me, se, de, task, e, action, t, ws, nodes):
         most = task.pressure_rate * task.control_dt
         pressure = task.setpoint[e] + min(most, max(-most, command - task.setpoint[e]))
         if pressure != task.setpoint[e]:
-            ramp_rest_pressure(me, de, 0, pressure, t, (task.steps[e] + 1) * task.control_dt, ws)
+            ramp_rest_pressure(me, de, env_ring(), pressure, t, (task.steps[e] + 1) * task.control_dt, ws)
             task.setpoint[e] = pressure
-            task.rest_radius[e] = rest_circle_radius(me, 0, pressure, n)
+            task.rest_radius[e] = rest_circle_radius(me, env_ring(), pressure, n)
         return
     impulse = 0.5 * (action + 1.0) * task.paddle_max_impulse
     if not task.in_reach[e] or impulse <= 0.0:
@@ -290,7 +299,7 @@ def _actuate(me, se, de, task, e, action, t, ws, nodes):
         if x[i, 1] >= top - task.paddle_depth:
             nodes[count] = i
             count += 1
-    spread_impulse(de, 0, nodes, count, 0.0, -impulse, t, t + task.paddle_strike_duration)
+    spread_impulse(de, env_ring(), nodes, count, 0.0, -impulse, t, t + task.paddle_strike_duration)
     task.impulse[e] = impulse
     task.struck[e] = True
 
@@ -352,18 +361,25 @@ def step_env(
 
 @kernel(nogil=True)
 def step_batch(
-    model, solver, ws, state, trial, drive, clocks, counters, records, events, task, actions, active, nodes,
-    obs, low, high, out,
+    model, solver, ws, state, trial, drive, clocks, counters, records, events, task, actions, active,
+    chunks, tickets, nodes, obs, low, high, out,
 ):  # fmt: skip
     """One control step (:func:`step_env`) of every env ``e`` with ``active[e]``, with action
-    ``actions[e]``, one after the other. Runs without the GIL: threads may step disjoint sets of
-    envs at once, each with its own scratch ``ws``, ``nodes``."""
-    for e in range(actions.shape[0]):
-        if active[e]:
-            step_env(
-                model, solver, ws, state, trial, drive, clocks, counters, records, events, task, e,
-                actions[e], nodes, obs, low, high, out,
-            )  # fmt: skip
+    ``actions[e]``, chunk by chunk: chunk ``k`` is envs ``chunks[k]`` to ``chunks[k + 1] - 1``, and
+    the call steps the chunks whose numbers it draws from ``tickets`` (:func:`.tickets.draw_ticket`)
+    until none are left. Runs without the GIL: threads calling it at once, each with its own
+    scratch ``ws``, ``nodes``, share the chunks out between them, each chunk to the first thread free
+    to draw it."""
+    while True:
+        k = draw_ticket(tickets)
+        if k >= chunks.shape[0] - 1:
+            return
+        for e in range(chunks[k], chunks[k + 1]):
+            if active[e]:
+                step_env(
+                    model, solver, ws, state, trial, drive, clocks, counters, records, events, task, e,
+                    actions[e], nodes, obs, low, high, out,
+                )  # fmt: skip
 
 
 @kernel
@@ -446,7 +462,7 @@ def observe_env(model, state, task, e, row):
     centre_velocity = field_start(OBS_CENTRE_OF_MASS_VELOCITY, n)
     row[centre_velocity] = ux
     row[centre_velocity + 1] = uy
-    row[field_start(OBS_PRESSURE, n)] = ring_pressure(env_model(model, e), 0, x)
+    row[field_start(OBS_PRESSURE, n)] = ring_pressure(env_model(model, e), env_ring(), x)
     row[field_start(OBS_PRESSURE_SETPOINT, n)] = task.setpoint[e]
     row[field_start(OBS_TARGET_HEIGHT, n)] = task.target[e]
     row[field_start(OBS_LAST_APEX, n)] = task.last_apex[e]
@@ -472,12 +488,12 @@ class BallBatch:
     ``obs`` (E, D) float32 holds the observations clipped to ``[low, high]``; ``task.reward`` the
     reward and its terms, ``task.end`` how each episode ended (``END_*``).
 
-    With ``threads`` > 1 a step is cut into contiguous chunks of envs (:func:`guided_chunks`), each a
-    :func:`step_batch` call (without the GIL) taken by whichever thread (the caller's and
-    ``threads - 1`` others) is free, with that thread's scratch: envs cost unequal and changing
-    amounts (a bounce, a strike), so fixed shares would leave one thread waiting. Chunks write
-    disjoint, contiguous rows and scratch carries nothing from one env to the next: every env's
-    numbers are those of one thread, to the bit."""
+    With ``threads`` > 1 a step is cut into contiguous chunks of envs (:func:`guided_chunks`); each
+    thread (the caller's and ``threads - 1`` others) makes one :func:`step_batch` call (without the
+    GIL) with its own scratch, and inside it draws the chunks one after the other, each going to the
+    first thread free: envs cost unequal and changing amounts (a bounce, a strike), so fixed shares
+    would leave one thread waiting. Chunks write disjoint, contiguous rows and scratch carries
+    nothing from one env to the next: every env's numbers are those of one thread, to the bit."""
 
     def __init__(
         self,
@@ -533,15 +549,15 @@ class BallBatch:
         self.nodes = np.zeros(self.n_nodes, dtype=np.int64)
         self.threads = max(1, min(int(threads), n_envs))
         self._pool: ThreadPoolExecutor | None = None
+        # chunk boundaries (one chunk of all envs on one thread) and the counter their numbers are drawn from
+        self._chunks = np.array(guided_chunks(n_envs, self.threads) if self.threads > 1 else [0, n_envs])
+        self._tickets = np.zeros(1, dtype=np.int64)
         if self.threads > 1:
             self._pool = ThreadPoolExecutor(self.threads - 1, thread_name_prefix="ballenv")
             self._scratch = [(self.ws, self.nodes)] + [
                 (self._scratch_workspace(barrier), np.zeros(self.n_nodes, dtype=np.int64))
                 for _ in range(self.threads - 1)
             ]
-            bounds = guided_chunks(n_envs, self.threads)
-            envs = np.arange(n_envs)
-            self._chunks = np.array([(envs >= a) & (envs < b) for a, b in itertools.pairwise(bounds)])
         self.low = np.asarray(low, dtype=np.float64)
         self.high = np.asarray(high, dtype=np.float64)
         self.raw = np.zeros((n_envs, observation_size(self.n_nodes, self.task.mode)))
@@ -571,42 +587,28 @@ class BallBatch:
         float64 in [-1, 1]."""
         active = self.all if active is None else np.ascontiguousarray(active, dtype=np.bool_)
         actions = np.ascontiguousarray(actions, dtype=np.float64)
+        self._tickets[0] = 0
         if self._pool is None:
             self._step(self.ws, self.nodes, actions, active)
             return
-        if self._step_batch is None:
-            self._step(self.ws, self.nodes, actions, np.zeros_like(active))  # compile or load, once
-        tickets = itertools.count()  # chunk k goes to the thread that draws ticket k
-        calls = [
-            self._pool.submit(self._step_chunks, tickets, actions, active, ws, nodes)
-            for ws, nodes in self._scratch[1:]
-        ]
+        if self._step_batch is None:  # compile or load, once, before the threads call it
+            self._step(self.ws, self.nodes, actions, np.zeros_like(active))
+            self._tickets[0] = 0
+        calls = [self._pool.submit(self._step, ws, nodes, actions, active) for ws, nodes in self._scratch[1:]]
         try:
-            self._step_chunks(tickets, actions, active, *self._scratch[0])
+            self._step(*self._scratch[0], actions, active)
         finally:  # every thread done before this returns or raises
             for call in calls:
                 call.result()
 
-    def _step_chunks(
-        self,
-        tickets: Iterator[int],
-        actions: NDArray[np.float64],
-        active: NDArray[np.bool_],
-        ws: Workspace,
-        nodes: NDArray[np.int64],
-    ) -> None:
-        for k in tickets:
-            if k >= len(self._chunks):
-                return
-            self._step(ws, nodes, actions, active & self._chunks[k])
-
     def _step(
         self, ws: Workspace, nodes: NDArray[np.int64], actions: NDArray[np.float64], active: NDArray[np.bool_]
     ) -> None:
+        """One :func:`step_batch` call with scratch ``ws``, ``nodes``: the chunks it draws."""
         args = (
             self.model, self.solver, ws, self.state, self.trial, self.drive, self.clocks, self.counters,
-            self.records, self.records.events, self.task, actions, active, nodes, self.raw, self.low,
-            self.high, self.obs,
+            self.records, self.records.events, self.task, actions, active, self._chunks, self._tickets,
+            nodes, self.raw, self.low, self.high, self.obs,
         )  # fmt: skip
         if self._step_batch is None:
             self._step_batch = compiled_entry(step_batch, args)
@@ -622,7 +624,7 @@ class BallBatch:
 def guided_chunks(n_envs: int, threads: int) -> list[int]:
     """Boundaries ``[0, b_1, ..., n_envs]`` of the chunks a threaded step hands out, in the order
     they are drawn: each chunk is ``1 / (2 threads)`` of the envs still left (guided scheduling), so
-    the first are large (few calls, each unboxing the step's ~100 arrays) and the last single envs
+    the first are large (long runs of envs one thread steps in a row) and the last single envs
     (a thread finishing early has small pieces left to take instead of waiting for the other's
     last large one). While at least ``ENVS_PER_LINE`` envs are left, chunks are whole multiples of
     it: the per-env arrays' cache lines are then written by one thread only."""
