@@ -1,4 +1,4 @@
-"""Scripted controllers for InflatedBall-v2: the heuristics that learned policies are measured against.
+"""Scripted controllers for InflatedBall-v3: the heuristics that learned policies are measured against.
 
 Both read only the observation (through the env's ``observation_structure``, name -> slice) and keep a
 little memory of the current bounce. Call ``reset()`` at each episode start and ``act(obs)`` at each step.

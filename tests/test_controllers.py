@@ -30,7 +30,7 @@ def _episode(env, seed, controller, idle):
     [("pressure", (0.85, 0.95)), ("paddle", (0.6, 0.7))],
 )
 def test_scripted_controller_keeps_the_target_the_uncontrolled_ball_cannot(mode, targets):
-    env = gym.make("InflatedBall-v2", action_mode=mode, target_height_range=targets)
+    env = gym.make("InflatedBall-v3", action_mode=mode, target_height_range=targets)
     structure = env.unwrapped.observation_structure
     config = env.unwrapped.config
     if mode == "pressure":
