@@ -1,4 +1,4 @@
-"""The README's main job: train a Stable-Baselines3 agent on InflatedBall-v2 and score it.
+"""The README's main job: train a Stable-Baselines3 agent on InflatedBall-v3 and score it.
 
     python train.py --algo ppo --action-mode pressure    # = make train (which adds --vec-env subproc)
 

@@ -1,4 +1,4 @@
-"""Agents for InflatedBall-v2: baseline policies, per-algorithm hyperparameters, evaluation.
+"""Agents for InflatedBall-v3: baseline policies, per-algorithm hyperparameters, evaluation.
 
 * ``agents.baselines``: random actions and the scripted heuristics of ``ballenv.controllers``
   (pressure pumping, paddle dribbling), and a saved Stable-Baselines3 model, behind one interface.

@@ -1,4 +1,4 @@
-"""Policies for InflatedBall-v2 behind one interface: ``reset(seed)`` at an episode start, then
+"""Policies for InflatedBall-v3 behind one interface: ``reset(seed)`` at an episode start, then
 ``act(obs) -> action`` (float32 array of shape (1,)).
 
 * :class:`RandomPolicy`: uniform actions in [-1, 1] from its own seeded generator;

@@ -1,4 +1,4 @@
-"""Score a policy on InflatedBall-v2 over held-out episodes.
+"""Score a policy on InflatedBall-v3 over held-out episodes.
 
     ballenv-evaluate heuristic --action-mode pressure --episodes 20   # or python -m agents.evaluate
     python -m agents.evaluate random --action-mode paddle
@@ -37,7 +37,7 @@ from ballenv.envs.inflated_ball import ball_env
 
 from .baselines import Policy, make_policy
 
-ENV_ID = "ballenv:InflatedBall-v2"
+ENV_ID = "ballenv:InflatedBall-v3"
 SUCCESS_TOLERANCE = 0.05  # relative apex error counted as a success
 DEFAULT_SEED = 10_000
 

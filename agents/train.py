@@ -1,4 +1,4 @@
-"""Train a Stable-Baselines3 agent on InflatedBall-v2, then score it next to the baselines.
+"""Train a Stable-Baselines3 agent on InflatedBall-v3, then score it next to the baselines.
 
     python train.py --algo ppo --action-mode pressure            # the README's main command
     python train.py --algo sac --action-mode paddle --total-timesteps 50000 --seed 3

@@ -1,8 +1,8 @@
 """ballenv: an inflated elastic ball (a 2-D ring of discrete elastic rods) as an RL environment.
 
-Importing the package registers ``InflatedBall-v2`` with Gymnasium (Gymnasium 1.x has no plugin
-entry point): ``import ballenv; gym.make("InflatedBall-v2")``, or, without the import (e.g. in
-spawned subprocesses), ``gym.make("ballenv:InflatedBall-v2")``. Without gymnasium installed the
+Importing the package registers ``InflatedBall-v3`` with Gymnasium (Gymnasium 1.x has no plugin
+entry point): ``import ballenv; gym.make("InflatedBall-v3")``, or, without the import (e.g. in
+spawned subprocesses), ``gym.make("ballenv:InflatedBall-v3")``. Without gymnasium installed the
 simulator, ``ballenv.physics``, still imports (it needs only numpy, numba and tqdm).
 """
 

@@ -1,4 +1,4 @@
-"""Scripted controllers for InflatedBall-v2: the heuristics that learned policies are measured against.
+"""Scripted controllers for InflatedBall-v3: the heuristics that learned policies are measured against.
 
 Both read only the observation (through the env's ``observation_structure``, name -> slice) and keep a
 little memory of the current bounce. Call ``reset()`` at each episode start and ``act(obs)`` at each step.
@@ -66,7 +66,9 @@ class PaddleDribble(_Controller):
     """Strike the ball once per flight as it falls through the paddle's reach, with the impulse
     that restores the energy of a bounce to the target: a ball of mass ``m`` falling at ``v`` gains
     ``v J + J^2 / 2m`` from an impulse ``J``; it needs ``m g (h_target - r) / retention - m g (apex -
-    r)``, ``retention`` being the fraction of its energy a bounce keeps."""
+    r)``, ``retention`` being the fraction of its energy a bounce keeps. The apex is the one it saw
+    the ball rise to, before the first the start height (``last_apex``): a ball dropped from below
+    the paddle's reach after one bounce must be struck on its first fall or it comes to rest."""
 
     def __init__(
         self,
@@ -94,8 +96,10 @@ class PaddleDribble(_Controller):
         if vy > 0.0:
             self.apex = y + vy * vy / (2.0 * self.g)
             return idle
+        if self.apex is None:  # the first fall, from the start height (rest): no apex seen yet
+            self.apex = float(obs[self.s["last_apex"]][0])
         in_reach = obs[self.s["paddle_in_reach"]][0] > 0.5
-        if self.struck or self.apex is None or not in_reach:
+        if self.struck or not in_reach:
             return idle
         self.struck = True
         m, g = self.mass, self.g

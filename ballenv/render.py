@@ -99,7 +99,7 @@ class BallRenderer:
         if self.window is None:
             pg.display.init()
             self.window = pg.display.set_mode((SIZE, SIZE))
-            pg.display.set_caption("InflatedBall-v2")
+            pg.display.set_caption("InflatedBall-v3")
             self.clock = pg.time.Clock()
         pg.event.pump()
         self.window.blit(pg.image.frombuffer(frame.tobytes(), (SIZE, SIZE), "RGB"), (0, 0))
@@ -113,7 +113,7 @@ class BallRenderer:
 
 
 def scripted(mode: str, **env_kwargs: Any) -> tuple[gym.Env[Any, Any], PressurePump | PaddleDribble]:
-    """InflatedBall-v2 (``action_mode=mode``, ``rgb_array`` frames) and its scripted controller
+    """InflatedBall-v3 (``action_mode=mode``, ``rgb_array`` frames) and its scripted controller
     (the pump or the dribble): ``(env, controller)``."""
     import gymnasium as gym
 
@@ -121,7 +121,7 @@ def scripted(mode: str, **env_kwargs: Any) -> tuple[gym.Env[Any, Any], PressureP
     from .envs.inflated_ball import ball_env
     from .physics.ring import total_mass
 
-    env = gym.make("InflatedBall-v2", action_mode=mode, render_mode="rgb_array", **env_kwargs)
+    env = gym.make("InflatedBall-v3", action_mode=mode, render_mode="rgb_array", **env_kwargs)
     ball = ball_env(env)
     config, structure = ball.config, ball.observation_structure
     if mode == "pressure":
@@ -202,7 +202,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     import argparse
 
     parser = argparse.ArgumentParser(
-        prog="python -m ballenv.render", description="Write a frame strip or a clip of InflatedBall-v2."
+        prog="python -m ballenv.render", description="Write a frame strip or a clip of InflatedBall-v3."
     )
     parser.add_argument("--out", default="out/env.png", help="PNG file to write (default out/env.png)")
     parser.add_argument("--video", default=None, help="write a clip instead: a .mp4 or .gif file")

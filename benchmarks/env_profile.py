@@ -1,4 +1,4 @@
-"""Where an env step's time goes: a per-phase profile of InflatedBall-v2 with random actions.
+"""Where an env step's time goes: a per-phase profile of InflatedBall-v3 with random actions.
 
     python benchmarks/env_profile.py    # writes benchmarks/results/env_profile.md
 

@@ -1,4 +1,4 @@
-"""Throughput of InflatedBall-v2: env steps per second per fidelity preset and action mode, the native
+"""Throughput of InflatedBall-v3: env steps per second per fidelity preset and action mode, the native
 vector env against Gymnasium's SyncVectorEnv, and each preset's first-apex error.
 
     python benchmarks/env_throughput.py    # writes benchmarks/results/env_throughput.md and .png
@@ -50,7 +50,7 @@ def controller(env, mode, structure):
 
 
 def single_rate(preset, mode, policy, repeats=3):
-    env = gym.make("InflatedBall-v2", action_mode=mode, fidelity=preset)
+    env = gym.make("InflatedBall-v3", action_mode=mode, fidelity=preset)
     obs, info = env.reset(seed=0)
     ctrl = controller(env, mode, env.unwrapped.observation_structure)
     env.action_space.seed(0)
@@ -76,11 +76,11 @@ def vector_envs(n_envs, mode):
 
     def native(threads):
         return gym.make_vec(
-            "InflatedBall-v2", num_envs=n_envs, vectorization_mode="vector_entry_point", action_mode=mode,
+            "InflatedBall-v3", num_envs=n_envs, vectorization_mode="vector_entry_point", action_mode=mode,
             num_threads=threads,
         )  # fmt: skip
 
-    sync = gym.make_vec("InflatedBall-v2", num_envs=n_envs, vectorization_mode="sync", action_mode=mode)
+    sync = gym.make_vec("InflatedBall-v3", num_envs=n_envs, vectorization_mode="sync", action_mode=mode)
     return dict(zip(VECTOR_KINDS, (native(1), native(None), sync), strict=True))
 
 
@@ -160,7 +160,7 @@ def preset_errors():
 def main():
     RESULTS.mkdir(exist_ok=True)
     lines = [
-        "# InflatedBall-v2 throughput",
+        "# InflatedBall-v3 throughput",
         "",
         f"Single env, {SINGLE_STEPS} steps, best of 3 (env steps/s):",
         "",

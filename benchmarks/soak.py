@@ -14,7 +14,7 @@ ground, or inside another ring), energy growth (total energy above its start val
 1e-9 of the start's sum of |parts| plus the energy the collision impulses' push-out created), and
 how it ended (t_end, a documented SimulationError by reason, or anything else).
 
-Episodes: InflatedBall-v2 (fast preset), both action modes, 250 steps each (2.5 s) of uniform
+Episodes: InflatedBall-v3 (fast preset), both action modes, 250 steps each (2.5 s) of uniform
 random, extreme (+1 / -1) or alternating-extreme actions, resets included: non-finite or
 out-of-bounds observations, nodes below the ground, simulator failures.
 """
@@ -266,7 +266,7 @@ def main():
             )
         lines.append("")
     lines += [
-        "## Env episodes (InflatedBall-v2, fast preset)",
+        "## Env episodes (InflatedBall-v3, fast preset)",
         "",
         "| episodes | env steps | non-finite | out of bounds | below ground | simulator failures |",
         "|---:|---:|---:|---:|---:|---:|",

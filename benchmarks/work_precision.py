@@ -56,7 +56,7 @@ REFERENCE = dict(
 
 # --------------------------------------------------------------------------------------------- scenes
 def ball(n_nodes=64, pressure=30e3, position=(0.0, 1.0)):
-    """The env's ball (InflatedBall-v2 defaults) at rest."""
+    """The env's ball (InflatedBall-v3 defaults) at rest."""
     return Ring(
         radius=0.12, n_nodes=n_nodes, youngs_modulus=10e6, thickness=2e-3, width=0.02, density=1100.0,
         pressure=pressure, position=position,

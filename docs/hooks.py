@@ -180,7 +180,7 @@ def results_page(root, repo_path, text):
 
 
 def env_page(root):
-    """The page of InflatedBall-v2: the facts of its registration and spaces (from the code, as
+    """The page of InflatedBall-v3: the facts of its registration and spaces (from the code, as
     Gymnasium's environment pages begin), then the class docstring."""
     if str(root) not in sys.path:
         sys.path.insert(0, str(root))  # this checkout's ballenv, not an installed one
@@ -198,9 +198,9 @@ def env_page(root):
         rows.append(f"| `{env_id}` | `{spec.kwargs}` | {size} | {spec.max_episode_steps} |")
     return "\n".join(
         [
-            "# InflatedBall-v2",
+            "# InflatedBall-v3",
             "",
-            "![InflatedBall-v2](../env.png)",
+            "![InflatedBall-v3](../env.png)",
             "",
             f"*Top: the pressure mode; bottom: the paddle mode. This page is the docstring of "
             f"`{InflatedBallEnv.__module__}.{InflatedBallEnv.__name__}` (`{ENV_SOURCE}`).*",
@@ -209,7 +209,7 @@ def env_page(root):
             "|---|---|---|---:|",
             *rows,
             "",
-            '`import ballenv` registers the ids; `gymnasium.make("ballenv:InflatedBall-v2")` imports it.',
+            '`import ballenv` registers the ids; `gymnasium.make("ballenv:InflatedBall-v3")` imports it.',
             "",
             inspect.getdoc(InflatedBallEnv),
             "",

@@ -30,7 +30,7 @@ def _episode(env, seed, controller, idle):
     [("pressure", (0.85, 0.95)), ("paddle", (0.6, 0.7))],
 )
 def test_scripted_controller_keeps_the_target_the_uncontrolled_ball_cannot(mode, targets):
-    env = gym.make("InflatedBall-v2", action_mode=mode, target_height_range=targets)
+    env = gym.make("InflatedBall-v3", action_mode=mode, target_height_range=targets)
     structure = env.unwrapped.observation_structure
     config = env.unwrapped.config
     if mode == "pressure":
@@ -52,3 +52,25 @@ def test_scripted_controller_keeps_the_target_the_uncontrolled_ball_cannot(mode,
     # pumping is chaotic (the ring's vibrations): most episodes track the target within 20 %
     # (measured: 5 of 8; the other 3 sink into the pump's low-bounce trap, errors 0.53-0.73)
     assert np.median(controlled_errors) < 0.2, controlled_errors
+
+
+def test_paddle_dribble_strikes_the_first_fall_of_a_ball_released_under_a_high_target():
+    """Released at 0.6-0.62 m under a 0.95-1.0 m target, the ball's top is in the paddle's reach
+    only on its first fall: the controller strikes then (from the start height) and keeps it up."""
+    env = gym.make("InflatedBallPaddle-v3", start_height_range=(0.6, 0.62), target_height_range=(0.95, 1.0))
+    config = env.unwrapped.config
+    mass = total_mass(config.ring(config.initial_pressure))
+    controller = PaddleDribble(env.unwrapped.observation_structure, mass, retention=0.69)
+    for seed in range(2):
+        obs, _ = env.reset(seed=seed)
+        controller.reset()
+        first_strike, apexes = None, 0
+        for _ in range(1000):
+            obs, _, terminated, truncated, info = env.step(controller.act(obs))
+            apexes += info["apex_count"]
+            if info["paddle_impulse"] > 0.0 and first_strike is None:
+                first_strike = apexes
+            if terminated or truncated:
+                break
+        assert first_strike == 0  # before the first flight apex
+        assert info["termination"] == ""  # still bouncing at the time limit

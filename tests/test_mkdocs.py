@@ -17,7 +17,7 @@ def test_the_site_builds_without_warnings(tmp_path):
     assert result.returncode == 0, result.stdout + result.stderr
     assert "WARNING" not in result.stderr, result.stderr
     env_page = (site / "envs" / "inflated_ball" / "index.html").read_text()
-    assert "Version History" in env_page and "InflatedBallPaddle-v2" in env_page  # from the docstring
+    assert "Version History" in env_page and "InflatedBallPaddle-v3" in env_page  # from the docstring
     benchmarks = (site / "benchmarks" / "index.html").read_text()
     assert 'title="table' not in benchmarks  # every table link became its table
     assert "Two commands" in (site / "index.html").read_text()  # the README

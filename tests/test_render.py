@@ -29,7 +29,7 @@ def test_the_frame_strip_goes_to_out_by_default_not_over_a_tracked_file(tmp_path
 
 def test_rgb_array_frames_need_no_pygame(monkeypatch):
     monkeypatch.setitem(sys.modules, "pygame", None)  # `import pygame` raises ImportError
-    env = gym.make("InflatedBall-v2", action_mode="paddle", render_mode="rgb_array")
+    env = gym.make("InflatedBall-v3", action_mode="paddle", render_mode="rgb_array")
     env.reset(seed=0)
     frame = env.render()
     assert frame.shape == (SIZE, SIZE, 3) and frame.dtype == np.uint8
@@ -42,7 +42,7 @@ def test_human_mode_shows_the_same_frame_in_a_window(monkeypatch):
     monkeypatch.setenv("SDL_VIDEODRIVER", "dummy")
     import pygame
 
-    env = gym.make("InflatedBall-v2", render_mode="human")
+    env = gym.make("InflatedBall-v3", render_mode="human")
     env.reset(seed=0)  # human mode draws at reset and at each step
     shown = np.transpose(pygame.surfarray.array3d(pygame.display.get_surface()), (1, 0, 2))
     renderer = env.unwrapped._renderer

@@ -40,7 +40,7 @@ def test_train_runs_end_to_end_and_the_saved_agent_reloads(algo, mode, tmp_path)
     assert any((run / "tensorboard").rglob("events.out.tfevents*"))
     config = yaml.safe_load((run / "config.yml").read_text())
     assert config["seed"] == 3 and config["algo"] == algo and config["env_kwargs"]["action_mode"] == mode
-    ids = {"pressure": "ballenv:InflatedBall-v2", "paddle": "ballenv:InflatedBallPaddle-v2"}
+    ids = {"pressure": "ballenv:InflatedBall-v3", "paddle": "ballenv:InflatedBallPaddle-v3"}
     assert config["env_id"] == ids[mode]
     assert "--total-timesteps 256" in (run / "command.txt").read_text()
     scores = json.loads((run / "scores.json").read_text())
@@ -92,7 +92,7 @@ def test_a_failed_setup_leaves_no_run_folder(tmp_path):
     runs = tmp_path / "runs"
     quick = ["--total-timesteps", "64", "--final-episodes", "0", "--log-dir", str(runs)]
     # an env keyword the env refuses (the default pressure range bursts a 0.1 MPa wall)
-    with pytest.raises(ValueError, match=r"InflatedBall-v2\.pressure_range"):
+    with pytest.raises(ValueError, match=r"InflatedBall-v3\.pressure_range"):
         train(parse_args(["--env-kwargs", '{"youngs_modulus": 1e5}', *quick]))
     assert not runs.exists()
     # PPO refusing its hyperparameters once the envs are open; an earlier run in runs/ stays

@@ -38,7 +38,7 @@ def test_ppo_search_trains_trials_and_writes_the_best_in_zoo_format(tmp_path):
         "--env-kwargs", json.dumps(SHORT), "--eval-episodes", "1",
     ])  # fmt: skip
     best = yaml.safe_load((tmp_path / "ppo_pressure.yml").read_text())
-    entry = best["InflatedBall-v2"]
+    entry = best["InflatedBall-v3"]
     assert entry["n_steps"] in (256, 512, 1024) and np.isfinite(entry["learning_rate"])
     assert "complete" in (tmp_path / "ppo_pressure.md").read_text()
     evaluations = np.load(next((tmp_path / "ppo_pressure").glob("*/evaluations.npz")))

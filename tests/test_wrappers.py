@@ -23,8 +23,8 @@ def test_ball_state_observation_refuses_another_env():
 
 @pytest.mark.parametrize("mode", ["pressure", "paddle"])
 def test_ball_state_keeps_the_body_fields_and_the_total_ground_force(mode):
-    raw = gym.make("InflatedBall-v2", action_mode=mode)
-    env = BallStateObservation(gym.make("InflatedBall-v2", action_mode=mode))
+    raw = gym.make("InflatedBall-v3", action_mode=mode)
+    env = BallStateObservation(gym.make("InflatedBall-v3", action_mode=mode))
     s = raw.unwrapped.observation_structure
     assert env.observation_space.shape == ((9,) if mode == "pressure" else (12,))
     obs, _ = env.reset(seed=5)

@@ -1,10 +1,10 @@
-"""Gymnasium environments: InflatedBall-v2 (single) and its native vector env, registered once per
+"""Gymnasium environments: InflatedBall-v3 (single) and its native vector env, registered once per
 action mode (one id per mode, as the RL Baselines3 Zoo keys its hyperparameters)."""
 
 from gymnasium.envs.registration import register, registry
 
-ENV_ID = "InflatedBall-v2"
-PADDLE_ENV_ID = "InflatedBallPaddle-v2"  # InflatedBall-v2 with action_mode="paddle"
+ENV_ID = "InflatedBall-v3"
+PADDLE_ENV_ID = "InflatedBallPaddle-v3"  # InflatedBall-v3 with action_mode="paddle"
 ENV_IDS = {"pressure": ENV_ID, "paddle": PADDLE_ENV_ID}  # action mode -> its env id
 MAX_EPISODE_STEPS = 1000
 

@@ -1,4 +1,4 @@
-"""Many bouncing balls advanced in one compiled call: the physics behind InflatedBall-v2.
+"""Many bouncing balls advanced in one compiled call: the physics behind InflatedBall-v3.
 
 Every env holds one ring above one flat ground; the rings share material and numerical settings
 and differ in state, gas and target. One :class:`Model` with per-ring arrays of length E holds all
@@ -260,10 +260,13 @@ def _top(x):
 @kernel(inline="always")
 def _paddle_ready(task, e, x, v):
     """Whether the paddle can strike env ``e``'s ball (positions ``x``, velocities ``v``): paddle
-    mode, the ball falling (its centre of mass moving down) with its top within ``paddle_reach`` of
-    the paddle, and no strike yet since the ball last touched the ground (one strike per flight, as
-    a hand dribbles: it meets the ball coming down)."""
-    if task.mode != MODE_PADDLE or task.struck[e]:
+    mode, the ball in flight (no ground contact since its last lift-off) and falling (its centre of
+    mass moving down) with its top within ``paddle_reach`` of the paddle, and no strike yet in this
+    flight (one strike per flight, as a hand dribbles: it meets the ball coming down). Not on the
+    ground: a squashing ball's centre still moves down, and a strike there (energy ``v J`` at the
+    landing speed ``v``) doubled the bounce's energy for low targets, whose paddle reaches the
+    ground."""
+    if task.mode != MODE_PADDLE or task.struck[e] or not task.airborne[e]:
         return False
     falling = 0.0
     for i in range(v.shape[0]):

@@ -1,4 +1,4 @@
-"""The keyword arguments of InflatedBall-v2, validated once, and what both envs derive from them:
+"""The keyword arguments of InflatedBall-v3, validated once, and what both envs derive from them:
 the physics scene, the task settings, the observation bounds, and the reward and episode end."""
 
 from __future__ import annotations
@@ -30,7 +30,7 @@ FAILURES = {
 
 @dataclass(frozen=True)
 class BallEnvConfig:
-    """Keyword arguments of InflatedBall-v2 (SI units); see the env's Arguments table."""
+    """Keyword arguments of InflatedBall-v3 (SI units); see the env's Arguments table."""
 
     action_mode: str = "pressure"
     fidelity: str = "fast"
@@ -59,7 +59,7 @@ class BallEnvConfig:
     rest_height: float = 0.01
 
     def __post_init__(self) -> None:
-        o = "InflatedBall-v2"
+        o = "InflatedBall-v3"
         s = object.__setattr__
         check_choice(o, "action_mode", self.action_mode, tuple(ACTION_MODES))
         check_choice(o, "fidelity", self.fidelity, tuple(FIDELITY_PRESETS))
@@ -176,7 +176,7 @@ class BallEnvConfig:
         unknown = sorted(set(kwargs) - known)
         if unknown:
             raise TypeError(
-                f"InflatedBall-v2 got unknown keyword arguments {unknown}; known: {sorted(known)}"
+                f"InflatedBall-v3 got unknown keyword arguments {unknown}; known: {sorted(known)}"
             )
         return cls(**kwargs)
 
@@ -187,7 +187,7 @@ def _check_wall(config: BallEnvConfig) -> None:
     try:
         config.ring(None)
     except ValueError as err:
-        raise ValueError(str(err).replace("Ring.", "InflatedBall-v2.", 1)) from None
+        raise ValueError(str(err).replace("Ring.", "InflatedBall-v3.", 1)) from None
 
 
 def _check_wall_holds(config: BallEnvConfig, name: str, pressure: float) -> None:
@@ -196,7 +196,7 @@ def _check_wall_holds(config: BallEnvConfig, name: str, pressure: float) -> None
     held = burst_pressure(config.radius, config.n_nodes, config.youngs_modulus, config.thickness)
     if pressure > held:
         raise ValueError(
-            f"InflatedBall-v2.{name} = {getattr(config, name)!r} is out of range: {pressure:g} Pa must be "
+            f"InflatedBall-v3.{name} = {getattr(config, name)!r} is out of range: {pressure:g} Pa must be "
             f"at most {held:.6g} Pa, the gauge pressure that stretches the wall (radius = {config.radius:g} "
             f"m, youngs_modulus = {config.youngs_modulus:g} Pa, thickness = {config.thickness:g} m) by "
             f"100 %; beyond, the ball bursts: lower {name} or stiffen the wall (youngs_modulus, thickness)"
@@ -227,7 +227,7 @@ def parse_actions(actions: ArrayLike, count: int, what: str) -> NDArray[np.float
             return a
     shape = "(1,)" if count == 1 else f"({count}, 1)"
     raise ValueError(
-        f"InflatedBall-v2 {what} = {actions!r} is invalid: must be {count} finite real number"
+        f"InflatedBall-v3 {what} = {actions!r} is invalid: must be {count} finite real number"
         f"{'s' if count > 1 else ''} (shape {shape}; values outside [-1, 1] are clipped)"
     )
 
@@ -237,7 +237,7 @@ def check_reset(has_reset: bool, call: str) -> None:
     reset: until then the ball has no state (its arrays are zeros)."""
     if not has_reset:
         raise ResetNeeded(
-            f"InflatedBall-v2 {call}() was called before reset(): call reset() first, which places "
+            f"InflatedBall-v3 {call}() was called before reset(): call reset() first, which places "
             "the ball and draws the episode's target"
         )
 

@@ -1,4 +1,4 @@
-"""The observation vector of InflatedBall-v2, declared once.
+"""The observation vector of InflatedBall-v3, declared once.
 
 :data:`FIELDS` lists the entries of every observation in order, :data:`PADDLE_FIELDS` those that
 paddle mode appends. Everything else is derived from these two tables: the length of the vector
@@ -98,7 +98,7 @@ PADDLE_FIELDS = (
     ),
     Field(
         "paddle_in_reach", 0, 1, lambda c: 0.0, lambda c: 1.0, "-",
-        "1 if the paddle can strike at the next step, else 0 (a falling ball, once per flight)",
+        "1 if the paddle can strike at the next step, else 0 (a falling ball in flight, once per flight)",
     ),
     Field(
         "paddle_impulse", 0, 1, lambda c: 0.0, lambda c: c.paddle_max_impulse, "N s",

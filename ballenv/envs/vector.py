@@ -1,6 +1,6 @@
-"""A native vector env of InflatedBall-v2: all balls stepped in one compiled call.
+"""A native vector env of InflatedBall-v3: all balls stepped in one compiled call.
 
-``gym.make_vec("InflatedBall-v2", num_envs=64, vectorization_mode="vector_entry_point", **kwargs)``.
+``gym.make_vec("InflatedBall-v3", num_envs=64, vectorization_mode="vector_entry_point", **kwargs)``.
 Env ``i`` uses the random stream of a single env reset with ``seed + i`` (as ``SyncVectorEnv``
 seeds its envs) and the same compiled step, so it reproduces single envs exactly. Autoreset follows
 Gymnasium's default ``NEXT_STEP`` mode: the step after an episode ends resets that env, ignores its
@@ -39,7 +39,7 @@ DEFAULT_MAX_EPISODE_STEPS = 1000
 
 
 class InflatedBallVectorEnv(VectorEnv[NDArray[np.float32], NDArray[np.float32], NDArray[Any]]):
-    """``num_envs`` InflatedBall-v2 episodes advanced together (see :class:`InflatedBallEnv` for the
+    """``num_envs`` InflatedBall-v3 episodes advanced together (see :class:`InflatedBallEnv` for the
     task, spaces and keyword arguments; ``max_episode_steps`` truncates each episode).
 
     ``num_threads`` (default: numba's thread count, the machine's cores, at most ``num_envs``) steps
@@ -62,7 +62,7 @@ class InflatedBallVectorEnv(VectorEnv[NDArray[np.float32], NDArray[np.float32], 
     ) -> None:
         if isinstance(num_envs, bool) or not isinstance(num_envs, int) or not 1 <= num_envs <= 100_000:
             raise ValueError(
-                f"InflatedBall-v2.num_envs = {num_envs!r} is out of range: must be an integer in [1, 100000]"
+                f"InflatedBall-v3.num_envs = {num_envs!r} is out of range: must be an integer in [1, 100000]"
             )
         if (
             isinstance(max_episode_steps, bool)
@@ -70,12 +70,12 @@ class InflatedBallVectorEnv(VectorEnv[NDArray[np.float32], NDArray[np.float32], 
             or max_episode_steps < 1
         ):
             raise ValueError(
-                f"InflatedBall-v2.max_episode_steps = {max_episode_steps!r} is out of range: must be an "
+                f"InflatedBall-v3.max_episode_steps = {max_episode_steps!r} is out of range: must be an "
                 "integer >= 1"
             )
         if render_mode not in (None, "rgb_array"):
             raise ValueError(
-                f"InflatedBall-v2 vector render_mode = {render_mode!r} is out of range: must be None "
+                f"InflatedBall-v3 vector render_mode = {render_mode!r} is out of range: must be None "
                 "or 'rgb_array'"
             )
         # numba sets its config's values at import: its type stubs do not declare them
@@ -84,7 +84,7 @@ class InflatedBallVectorEnv(VectorEnv[NDArray[np.float32], NDArray[np.float32], 
             num_threads = min(numba.get_num_threads(), num_envs)
         if isinstance(num_threads, bool) or not isinstance(num_threads, int) or not 1 <= num_threads <= most:
             raise ValueError(
-                f"InflatedBall-v2.num_threads = {num_threads!r} is out of range: must be an integer in "
+                f"InflatedBall-v3.num_threads = {num_threads!r} is out of range: must be an integer in "
                 f"[1, {most}] (numba's NUMBA_NUM_THREADS)"
             )
         self.config = BallEnvConfig.from_kwargs(kwargs)
@@ -125,7 +125,7 @@ class InflatedBallVectorEnv(VectorEnv[NDArray[np.float32], NDArray[np.float32], 
             seeds = list(seed)
             if len(seeds) != self.num_envs:
                 raise ValueError(
-                    f"InflatedBall-v2 vector reset seed has {len(seeds)} entries: must have "
+                    f"InflatedBall-v3 vector reset seed has {len(seeds)} entries: must have "
                     f"num_envs = {self.num_envs}"
                 )
         for i, s in enumerate(seeds):

@@ -32,7 +32,7 @@ def test_height_reward_is_deepmind_controls_gaussian_tolerance():
 
 @pytest.mark.parametrize("mode", MODES)
 def test_reward_is_in_zero_one_and_is_the_sum_of_its_terms(mode):
-    env = gym.make("InflatedBall-v2", action_mode=mode)
+    env = gym.make("InflatedBall-v3", action_mode=mode)
     env.reset(seed=4)
     env.action_space.seed(4)
     rewards = []
@@ -56,7 +56,7 @@ def test_reward_measures_the_ballistic_apex_rising_and_the_last_apex_falling():
     """Falling from rest, the reward is that of the start height (the ball's last apex, observed as
     ``last_apex``); rising after its first bounce, that of its ballistic apex ``y + vy^2 / 2g``;
     after that flight's apex, that of the apex event the env reported."""
-    env = gym.make("InflatedBall-v2")
+    env = gym.make("InflatedBall-v3")
     obs, info = env.reset(seed=2)
     s = env.unwrapped.observation_structure
     target, margin = info["target_height"], env.unwrapped.config.reward_margin
@@ -91,7 +91,7 @@ def test_reward_favours_the_paddle_strike_that_hits_the_target():
     target far better than one that ignores the loss (retention 1); the reward ranks them alike."""
     scores = {}
     for retention in (0.7, 1.0):
-        env = gym.make("InflatedBallPaddle-v2")
+        env = gym.make("InflatedBallPaddle-v3")
         config = env.unwrapped.config
         dribble = PaddleDribble(
             env.unwrapped.observation_structure, total_mass(config.ring(config.initial_pressure)),
@@ -119,7 +119,7 @@ def test_ending_early_never_pays(seed):
     until the ball rests (terminated early): its return is lower."""
 
     def episode(quit_at):
-        env = gym.make("InflatedBall-v2")
+        env = gym.make("InflatedBall-v3")
         obs, _ = env.reset(seed=seed)
         pump = PressurePump(env.unwrapped.observation_structure)
         total, steps = 0.0, 0
@@ -218,7 +218,40 @@ def test_a_spread_strike_is_a_different_motion_of_the_same_momentum():
 
 @pytest.mark.parametrize("duration", [0.0, 0.0101, float("nan"), -1e-3])
 def test_paddle_strike_duration_out_of_range_names_the_keyword_and_its_range(duration):
-    message = rf"^InflatedBall-v2\.paddle_strike_duration = {duration!r} is out of range: must be a finite "
+    message = rf"^InflatedBall-v3\.paddle_strike_duration = {duration!r} is out of range: must be a finite "
     message += r"number in \(0, 0\.01\] s \(at most one control step, 1 / control_frequency\)$"
     with pytest.raises(ValueError, match=message):
         InflatedBallEnv(action_mode="paddle", paddle_strike_duration=duration)
+
+
+@pytest.mark.parametrize("action", [-1.0, -0.8])
+def test_the_paddle_strikes_only_a_ball_in_flight(action):
+    """The paddle in reach everywhere (``paddle_reach`` 5 m): a falling ball in flight is in reach
+    (unless struck already in that flight), a ball touching the ground never, even while its centre
+    still moves down as it squashes (where a strike gained ``v J`` at the landing speed); every
+    strike delivered started from a step whose observation said in reach."""
+    env = gym.make("InflatedBallPaddle-v3", paddle_reach=5.0, target_height_range=(0.5, 0.51))
+    s = env.unwrapped.observation_structure
+    obs, _ = env.reset(seed=3)
+    squashing = falling_in_flight = strikes = 0
+    for _ in range(400):
+        in_reach = obs[s["paddle_in_reach"]][0] == 1.0
+        obs, _, terminated, truncated, info = env.step(np.array([action], dtype=np.float32))
+        if info["paddle_impulse"] > 0.0:
+            assert in_reach
+            strikes += 1
+        contact = obs[s["ground_normal_force"]].sum() > 0.0
+        falling = obs[s["centre_of_mass_velocity"]][1] < 0.0
+        if contact:
+            assert obs[s["paddle_in_reach"]][0] == 0.0
+            squashing += falling
+        elif falling and info["paddle_impulse"] == 0.0 and action == -1.0:
+            assert obs[s["paddle_in_reach"]][0] == 1.0  # never struck: in reach all the way down
+            falling_in_flight += 1
+        if terminated or truncated:
+            break
+    assert squashing > 0  # the case of the rule: on the ground, centre moving down
+    if action == -1.0:
+        assert strikes == 0 and falling_in_flight > 20
+    else:
+        assert strikes >= 3  # one per flight

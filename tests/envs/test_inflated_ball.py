@@ -1,4 +1,4 @@
-"""InflatedBall-v2 as Gymnasium and Stable-Baselines3 expect it: checkers, seeding, pickling,
+"""InflatedBall-v3 as Gymnasium and Stable-Baselines3 expect it: checkers, seeding, pickling,
 clear errors (extreme actions: tests/stability/test_env_extreme_actions.py)."""
 
 import pickle
@@ -21,7 +21,7 @@ MODES = ("pressure", "paddle")
 @pytest.mark.parametrize("mode", MODES)
 @pytest.mark.parametrize("render_mode", [None, "rgb_array", "human"])
 def test_gymnasium_check_env_passes_with_warnings_as_errors(mode, render_mode):
-    env = gym.make("InflatedBall-v2", action_mode=mode, render_mode=render_mode)
+    env = gym.make("InflatedBall-v3", action_mode=mode, render_mode=render_mode)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         check_env(env.unwrapped, skip_render_check=False)
@@ -38,23 +38,24 @@ def test_stable_baselines3_check_env_passes(mode):
 
 
 def test_registered_under_both_ids_with_a_time_limit():
-    for env_id in ("InflatedBall-v2", "ballenv:InflatedBall-v2"):
+    for env_id in ("InflatedBall-v3", "ballenv:InflatedBall-v3"):
         env = gym.make(env_id)
         assert env.spec.max_episode_steps == 1000
         assert isinstance(env.unwrapped, InflatedBallEnv)
     ballenv.register_envs()  # repeatable
-    assert gym.spec("InflatedBall-v2").entry_point == "ballenv.envs.inflated_ball:InflatedBallEnv"
-    for old in ("InflatedBall-v0", "InflatedBall-v1", "InflatedBallPaddle-v1"):  # older dynamics
+    assert gym.spec("InflatedBall-v3").entry_point == "ballenv.envs.inflated_ball:InflatedBallEnv"
+    older = ("InflatedBall-v0", "InflatedBall-v1", "InflatedBallPaddle-v1", "InflatedBall-v2")
+    for old in (*older, "InflatedBallPaddle-v2"):  # older dynamics
         assert old not in gym.registry
 
 
 def test_one_id_per_action_mode_and_a_keyword_overrides_it():
-    assert gym.make("InflatedBall-v2").unwrapped.config.action_mode == "pressure"
-    paddle = gym.make("ballenv:InflatedBallPaddle-v2")
+    assert gym.make("InflatedBall-v3").unwrapped.config.action_mode == "pressure"
+    paddle = gym.make("ballenv:InflatedBallPaddle-v3")
     assert paddle.unwrapped.config.action_mode == "paddle" and paddle.spec.max_episode_steps == 1000
     assert "paddle_height" in paddle.unwrapped.observation_structure
-    assert gym.make("InflatedBall-v2", action_mode="paddle").unwrapped.config.action_mode == "paddle"
-    venv = gym.make_vec("InflatedBallPaddle-v2", num_envs=2, vectorization_mode="vector_entry_point")
+    assert gym.make("InflatedBall-v3", action_mode="paddle").unwrapped.config.action_mode == "paddle"
+    venv = gym.make_vec("InflatedBallPaddle-v3", num_envs=2, vectorization_mode="vector_entry_point")
     assert venv.unwrapped.config.action_mode == "paddle"
 
 
@@ -76,11 +77,11 @@ def _rollout(env, seed, steps, actions=None):
 
 @pytest.mark.parametrize("mode", MODES)
 def test_same_seed_gives_identical_rollouts(mode):
-    a = _rollout(gym.make("InflatedBall-v2", action_mode=mode), 7, 200)
-    b = _rollout(gym.make("InflatedBall-v2", action_mode=mode), 7, 200)
+    a = _rollout(gym.make("InflatedBall-v3", action_mode=mode), 7, 200)
+    b = _rollout(gym.make("InflatedBall-v3", action_mode=mode), 7, 200)
     np.testing.assert_array_equal(a[0], b[0])
     np.testing.assert_array_equal(a[1], b[1])
-    c = _rollout(gym.make("InflatedBall-v2", action_mode=mode), 8, 200)
+    c = _rollout(gym.make("InflatedBall-v3", action_mode=mode), 8, 200)
     assert not np.array_equal(a[0][0], c[0][0])
 
 
@@ -133,11 +134,11 @@ def test_invalid_arguments_raise_value_error_naming_the_field(kwargs, field):
 def test_a_pressure_that_bursts_the_ball_is_reported_by_the_env_keyword(kwargs, message):
     # was "Ring.pressure = ... is out of range", a name the env's user never wrote
     held = r"83736\.5" if "youngs_modulus" not in kwargs else r"837\.365"
-    with pytest.raises(ValueError, match=rf"^InflatedBall-v2\.{message} must be at most {held} Pa") as err:
+    with pytest.raises(ValueError, match=rf"^InflatedBall-v3\.{message} must be at most {held} Pa") as err:
         InflatedBallEnv(**kwargs)
     assert "bursts" in str(err.value) and "Ring." not in str(err.value)
     with pytest.raises(
-        ValueError, match=r"^InflatedBall-v2\.thickness = 0\.2 is out of range: .*below radius"
+        ValueError, match=r"^InflatedBall-v3\.thickness = 0\.2 is out of range: .*below radius"
     ):
         InflatedBallEnv(thickness=0.2)
 
@@ -145,7 +146,7 @@ def test_a_pressure_that_bursts_the_ball_is_reported_by_the_env_keyword(kwargs, 
 def test_step_or_render_before_reset_asks_for_a_reset():
     # the unwrapped env (gym.make's OrderEnforcing wrapper says the same); was a ZeroDivisionError
     env = InflatedBallEnv(render_mode="rgb_array")
-    with pytest.raises(ResetNeeded, match=r"InflatedBall-v2 step\(\) was called before reset\(\)"):
+    with pytest.raises(ResetNeeded, match=r"InflatedBall-v3 step\(\) was called before reset\(\)"):
         env.step(np.zeros(1, dtype=np.float32))
     with pytest.raises(ResetNeeded, match=r"render\(\) was called before reset\(\)"):
         env.render()
@@ -170,7 +171,7 @@ def test_invalid_action_raises_and_out_of_range_actions_are_clipped():
 def test_rgb_array_render_is_an_image_and_opens_no_window():
     import pygame
 
-    env = gym.make("InflatedBall-v2", action_mode="paddle", render_mode="rgb_array")
+    env = gym.make("InflatedBall-v3", action_mode="paddle", render_mode="rgb_array")
     env.reset(seed=0)
     env.step(np.array([1.0], dtype=np.float32))
     frame = env.render()
@@ -183,7 +184,7 @@ def test_rgb_array_render_is_an_image_and_opens_no_window():
 def test_videos_play_in_real_time_one_frame_per_control_step(frequency):
     # RecordVideo writes the frames it collects at metadata["render_fps"]; RenderCollection collects
     # them the same way (one per reset and step) without a video encoder
-    env = RenderCollection(gym.make("InflatedBall-v2", control_frequency=frequency, render_mode="rgb_array"))
+    env = RenderCollection(gym.make("InflatedBall-v3", control_frequency=frequency, render_mode="rgb_array"))
     assert env.metadata["render_fps"] == frequency
     env.reset(seed=0)
     steps = 12
@@ -215,7 +216,7 @@ def test_pressure_actions_move_the_energy_budget_and_reset_starts_a_new_one():
 
 
 def test_ball_env_finds_the_env_under_wrappers_and_refuses_other_envs():
-    env = RenderCollection(gym.make("InflatedBall-v2", render_mode="rgb_array"))
+    env = RenderCollection(gym.make("InflatedBall-v3", render_mode="rgb_array"))
     assert isinstance(ball_env(env), InflatedBallEnv) and ball_env(env) is env.unwrapped
     with pytest.raises(TypeError, match="not an InflatedBall env"):
         ball_env(gym.make("CartPole-v1"))

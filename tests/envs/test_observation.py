@@ -114,7 +114,7 @@ def _step_until_struck(env, steps=300):
 
 @pytest.mark.parametrize("mode", MODES)
 def test_each_named_slice_holds_what_its_name_says(mode):
-    env = gym.make("InflatedBall-v2", action_mode=mode)
+    env = gym.make("InflatedBall-v3", action_mode=mode)
     structure = env.unwrapped.observation_structure
     obs, info = env.reset(seed=4)
     assert _mismatches(env, obs, info, structure) == []
@@ -179,7 +179,7 @@ def test_docstring_table_matches_the_declaration():
 def test_the_paddle_strikes_once_per_flight():
     """Action +1 held for 3 s: one strike between two touchdowns, and a strike in more than one
     flight (striking resumes once the ball has touched the ground)."""
-    env = gym.make("InflatedBallPaddle-v2")
+    env = gym.make("InflatedBallPaddle-v3")
     env.reset(seed=1)
     strikes, flights_struck = 0, 0
     for _ in range(300):

@@ -9,7 +9,7 @@ import ballenv  # noqa: F401  (registers the env)
 from ballenv.envs.vector import InflatedBallVectorEnv
 
 
-def _single_rollouts(n_envs, seed, actions, env_id="InflatedBall-v2", **kwargs):
+def _single_rollouts(n_envs, seed, actions, env_id="InflatedBall-v3", **kwargs):
     """Step n single envs as Gymnasium's NEXT_STEP autoreset does: the step after an episode ends
     resets that env and returns reward 0."""
     envs = [gym.make(env_id, **kwargs) for _ in range(n_envs)]
@@ -54,7 +54,7 @@ def test_native_vector_env_matches_single_envs_through_autoresets(mode):
     n_envs, steps = 4, 400
     actions = _actions(steps, n_envs)
     venv = gym.make_vec(
-        "InflatedBall-v2", num_envs=n_envs, vectorization_mode="vector_entry_point", action_mode=mode,
+        "InflatedBall-v3", num_envs=n_envs, vectorization_mode="vector_entry_point", action_mode=mode,
         max_episode_steps=150,
     )  # fmt: skip
     assert isinstance(venv.unwrapped, InflatedBallVectorEnv)
@@ -87,7 +87,7 @@ def test_threads_match_one_thread_bit_for_bit(mode):
 
 def test_sync_vector_env_matches_single_envs():
     actions = _actions(120, 2, seed=1)
-    venv = gym.make_vec("InflatedBall-v2", num_envs=2, vectorization_mode="sync")
+    venv = gym.make_vec("InflatedBall-v3", num_envs=2, vectorization_mode="sync")
     vec = _vector_rollouts(venv, 9, actions)
     single = _single_rollouts(2, 9, actions)
     np.testing.assert_array_equal(vec[0], single[0])
@@ -97,7 +97,7 @@ def test_sync_vector_env_matches_single_envs():
 def test_async_spawned_vector_env_matches_single_envs():
     actions = _actions(60, 2, seed=2)
     venv = gym.make_vec(
-        "ballenv:InflatedBall-v2", num_envs=2, vectorization_mode="async", vector_kwargs={"context": "spawn"}
+        "ballenv:InflatedBall-v3", num_envs=2, vectorization_mode="async", vector_kwargs={"context": "spawn"}
     )
     try:
         vec = _vector_rollouts(venv, 4, actions)
@@ -129,7 +129,7 @@ def test_vector_reset_takes_one_seed_per_env():
     venv = InflatedBallVectorEnv(num_envs=2)
     obs, info = venv.reset(seed=[7, 5])
     for i, seed in enumerate((7, 5)):
-        single_obs, single_info = gym.make("InflatedBall-v2").reset(seed=seed)
+        single_obs, single_info = gym.make("InflatedBall-v3").reset(seed=seed)
         np.testing.assert_array_equal(obs[i], single_obs)
         assert info["target_height"][i] == single_info["target_height"]
     with pytest.raises(ValueError, match="seed has 3 entries: must have num_envs = 2"):

@@ -243,7 +243,7 @@ def test_invalid_env_arguments_raise_naming_field_and_range(field):
     def run(value):
         with pytest.raises(ValueError) as err:
             InflatedBallEnv(**{field: value})
-        _assert_names_field(err, "(InflatedBall-v2|Ring)", field)  # material: checked by Ring
+        _assert_names_field(err, "(InflatedBall-v3|Ring)", field)  # material: checked by Ring
 
     run()
 
