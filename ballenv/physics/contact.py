@@ -54,7 +54,7 @@ FREE = -1
 PENETRATION_TOLERANCE = -1e-12  # m: a free node deeper than this below a ground gets constrained
 
 
-@kernel(inline="always")
+@kernel
 def frame(grounds, g, x, y):
     """Ground ``g``'s unit normal ``(nx, ny)`` into its free side at the point ``(x, y)`` (m) and the
     point's signed distance ``phi`` (m, positive on the free side): a half-plane's fixed ``n`` and
@@ -74,7 +74,7 @@ def frame(grounds, g, x, y):
     return side * rx / dist, side * ry / dist, phi
 
 
-@kernel(inline="always")
+@kernel
 def surface_velocity(grounds, g, x, y):
     """Velocity ``w`` (m/s) of ground ``g``'s surface at the point ``(x, y)`` (m): a half-plane's
     ``w(t)``, a drum's ``Omega (-(y - c_y), x - c_x)`` (``grounds``: rows ``layout.SURFACE``)."""
@@ -159,7 +159,7 @@ def sliding(grounds, g, x1, ve, i, eps):
     return nx, ny, tx, ty, mu, s, ds
 
 
-@kernel(inline="always")
+@kernel
 def drum_row_terms(grounds, g, x1, ve, i, rn, rt, mu, s, ds):
     """The terms (row vector, N/m) a drum adds to the derivative of node ``i``'s tangential row
     ``t . r_i + mu N_i s(v_t)`` by its own position ``x1[i]``, beyond the row combination of the
@@ -291,7 +291,7 @@ def rest_on_grounds(grounds, active, x1, v1, a1):
     return work
 
 
-@kernel(inline="always")
+@kernel
 def rest_on_drum(grounds, g, x1, v1, a1, i):
     """:func:`rest_on_grounds` for node ``i`` on drum ``g``: no normal velocity (a turning drum's
     surface moves along itself, so the velocity change does no work) and the normal acceleration
