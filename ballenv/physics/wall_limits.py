@@ -39,7 +39,7 @@ import math
 
 from .barrier import CCD_SAFETY, _smallest_root, beta, beta_curvature, beta_slope
 from .cyclic import next_node, prev_node
-from .effects.bending import _direction_gradients, _turning_angle
+from .effects.bending import _direction_gradients, _turning_angle, add_turning_blocks
 from .jit import kernel
 from .linalg import band_add_block
 
@@ -163,24 +163,7 @@ def _fold_hessian(band, pos, i, n, phi, e1x, e1y, e2x, e2y, kf, coef):
     d1, d2 = fold_terms(phi, kf)[1:]
     if d1 == 0.0 and d2 == 0.0:
         return
-    gpx, gpy, gnx, gny, s1, s2 = _direction_gradients(e1x, e1y, e2x, e2y)
-    gix, giy = -gpx - gnx, -gpy - gny
-    a1 = 2.0 * e1x * e1y / (s1 * s1)
-    b1 = (e1y * e1y - e1x * e1x) / (s1 * s1)
-    a2 = 2.0 * e2x * e2y / (s2 * s2)
-    b2 = (e2y * e2y - e2x * e2x) / (s2 * s2)
-    p = prev_node(i, n)
-    q = next_node(i, n)
-    c2, c1 = coef * d2, coef * d1
-    _block(band, pos, p, p, c2, c1, gpx, gpy, gpx, gpy, -a1, -b1)
-    _block(band, pos, p, i, c2, c1, gpx, gpy, gix, giy, a1, b1)
-    _block(band, pos, i, p, c2, c1, gix, giy, gpx, gpy, a1, b1)
-    _block(band, pos, i, i, c2, c1, gix, giy, gix, giy, a2 - a1, b2 - b1)
-    _block(band, pos, i, q, c2, c1, gix, giy, gnx, gny, -a2, -b2)
-    _block(band, pos, q, i, c2, c1, gnx, gny, gix, giy, -a2, -b2)
-    _block(band, pos, q, q, c2, c1, gnx, gny, gnx, gny, a2, b2)
-    _block(band, pos, p, q, c2, c1, gpx, gpy, gnx, gny, 0.0, 0.0)
-    _block(band, pos, q, p, c2, c1, gnx, gny, gpx, gpy, 0.0, 0.0)
+    add_turning_blocks(band, pos, i, n, e1x, e1y, e2x, e2y, _block, coef * d2, coef * d1)
 
 
 @kernel(inline="always")

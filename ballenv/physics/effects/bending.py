@@ -120,26 +120,33 @@ def bend_jacobian(x, rest_len, ei, rest_turn, coef, band, pos):
     k = ei / rest_len
     for i in range(n):
         phi, e1x, e1y, e2x, e2y = _turning_angle(x, i, n)
-        # gradient blocks: node a in (prev, i, next)
-        gpx, gpy, gnx, gny, s1, s2 = _direction_gradients(e1x, e1y, e2x, e2y)
-        gix, giy = -gpx - gnx, -gpy - gny
-        c = -coef * k
-        t = phi - rest_turn
-        a1 = 2.0 * e1x * e1y / (s1 * s1)
-        b1 = (e1y * e1y - e1x * e1x) / (s1 * s1)
-        a2 = 2.0 * e2x * e2y / (s2 * s2)
-        b2 = (e2y * e2y - e2x * e2x) / (s2 * s2)
-        p = prev_node(i, n)
-        q = next_node(i, n)
-        _bend_block(band, pos, p, p, c, t, gpx, gpy, gpx, gpy, -a1, -b1)
-        _bend_block(band, pos, p, i, c, t, gpx, gpy, gix, giy, a1, b1)
-        _bend_block(band, pos, i, p, c, t, gix, giy, gpx, gpy, a1, b1)
-        _bend_block(band, pos, i, i, c, t, gix, giy, gix, giy, a2 - a1, b2 - b1)
-        _bend_block(band, pos, i, q, c, t, gix, giy, gnx, gny, -a2, -b2)
-        _bend_block(band, pos, q, i, c, t, gnx, gny, gix, giy, -a2, -b2)
-        _bend_block(band, pos, q, q, c, t, gnx, gny, gnx, gny, a2, b2)
-        _bend_block(band, pos, p, q, c, t, gpx, gpy, gnx, gny, 0.0, 0.0)
-        _bend_block(band, pos, q, p, c, t, gnx, gny, gpx, gpy, 0.0, 0.0)
+        add_turning_blocks(band, pos, i, n, e1x, e1y, e2x, e2y, _bend_block, -coef * k, phi - rest_turn)
+
+
+@kernel(inline="always")
+def add_turning_blocks(band, pos, i, n, e1x, e1y, e2x, e2y, block, u, w):
+    """Add to ``band`` the nine node blocks (a, b), a and b in (prev, i, next), of a function of
+    node ``i``'s turning angle (edges ``e1``, ``e2``), each by ``block(band, pos, a, b, u, w, g_a,
+    g_b, ha, hb)`` from the gradient blocks ``g_a``, ``g_b`` (:func:`_direction_gradients`) and
+    ``hess phi``'s block ``[[ha, hb], [hb, -ha]]`` (module doc of :func:`bend_jacobian`); ``u``,
+    ``w``: the two weights ``block`` combines them with."""
+    gpx, gpy, gnx, gny, s1, s2 = _direction_gradients(e1x, e1y, e2x, e2y)
+    gix, giy = -gpx - gnx, -gpy - gny
+    a1 = 2.0 * e1x * e1y / (s1 * s1)
+    b1 = (e1y * e1y - e1x * e1x) / (s1 * s1)
+    a2 = 2.0 * e2x * e2y / (s2 * s2)
+    b2 = (e2y * e2y - e2x * e2x) / (s2 * s2)
+    p = prev_node(i, n)
+    q = next_node(i, n)
+    block(band, pos, p, p, u, w, gpx, gpy, gpx, gpy, -a1, -b1)
+    block(band, pos, p, i, u, w, gpx, gpy, gix, giy, a1, b1)
+    block(band, pos, i, p, u, w, gix, giy, gpx, gpy, a1, b1)
+    block(band, pos, i, i, u, w, gix, giy, gix, giy, a2 - a1, b2 - b1)
+    block(band, pos, i, q, u, w, gix, giy, gnx, gny, -a2, -b2)
+    block(band, pos, q, i, u, w, gnx, gny, gix, giy, -a2, -b2)
+    block(band, pos, q, q, u, w, gnx, gny, gnx, gny, a2, b2)
+    block(band, pos, p, q, u, w, gpx, gpy, gnx, gny, 0.0, 0.0)
+    block(band, pos, q, p, u, w, gnx, gny, gpx, gpy, 0.0, 0.0)
 
 
 @kernel
