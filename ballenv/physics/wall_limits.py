@@ -39,7 +39,7 @@ import math
 
 from .barrier import CCD_SAFETY, _smallest_root, beta, beta_curvature, beta_slope
 from .cyclic import next_node, prev_node
-from .effects.bending import _direction_gradients, _turning_angle, add_turning_blocks
+from .effects.bending import _direction_gradients, _edges, add_turning_blocks, turning_of
 from .jit import kernel
 from .linalg import band_add_block
 
@@ -86,9 +86,9 @@ def wall_limit_energy(x, rest_len, ea):
     s2 = (COLLAPSE_ON * rest_len) ** 2
     total = 0.0
     for i in range(n):
-        phi, e1x, e1y, e2x, e2y = _turning_angle(x, i, n)
-        if e1x * e2x + e1y * e2y < 0.0:
-            total += fold_terms(phi, kf)[0]
+        e1x, e1y, e2x, e2y = _edges(x, i, n)
+        if e1x * e2x + e1y * e2y < 0.0:  # turned beyond 90 degrees: the angle is needed
+            total += fold_terms(turning_of(e1x, e1y, e2x, e2y), kf)[0]
         length2 = e2x * e2x + e2y * e2y
         if length2 < s2:
             total += kc * beta(length2 / s2)
@@ -104,10 +104,10 @@ def wall_limit_force(x, rest_len, ea, f):
     kc = collapse_stiffness(ea, rest_len)
     s2 = (COLLAPSE_ON * rest_len) ** 2
     for i in range(n):
-        phi, e1x, e1y, e2x, e2y = _turning_angle(x, i, n)
+        e1x, e1y, e2x, e2y = _edges(x, i, n)
         q = next_node(i, n)
         if e1x * e2x + e1y * e2y < 0.0:
-            d1 = fold_terms(phi, kf)[1]
+            d1 = fold_terms(turning_of(e1x, e1y, e2x, e2y), kf)[1]
             if d1 != 0.0:
                 p = prev_node(i, n)
                 g1x, g1y, g2x, g2y = _direction_gradients(e1x, e1y, e2x, e2y)[:4]
@@ -138,10 +138,10 @@ def wall_limit_jacobian(x, rest_len, ea, coef, band, pos):
     kc = collapse_stiffness(ea, rest_len)
     s2 = (COLLAPSE_ON * rest_len) ** 2
     for i in range(n):
-        phi, e1x, e1y, e2x, e2y = _turning_angle(x, i, n)
+        e1x, e1y, e2x, e2y = _edges(x, i, n)
         q = next_node(i, n)
         if e1x * e2x + e1y * e2y < 0.0:
-            _fold_hessian(band, pos, i, n, phi, e1x, e1y, e2x, e2y, kf, coef)
+            _fold_hessian(band, pos, i, n, turning_of(e1x, e1y, e2x, e2y), e1x, e1y, e2x, e2y, kf, coef)
         length2 = e2x * e2x + e2y * e2y
         if length2 < s2 and length2 > 0.0:
             y = length2 / s2

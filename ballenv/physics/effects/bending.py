@@ -54,14 +54,23 @@ def energy(model, p, r, x, v):
 
 
 @kernel
-def _turning_angle(x, i, n):
+def _edges(x, i, n):
+    """Node ``i``'s edges ``e1 = x_i - x_{i-1}`` and ``e2 = x_{i+1} - x_i`` (m)."""
     p = prev_node(i, n)
     q = next_node(i, n)
-    e1x = x[i, 0] - x[p, 0]
-    e1y = x[i, 1] - x[p, 1]
-    e2x = x[q, 0] - x[i, 0]
-    e2y = x[q, 1] - x[i, 1]
-    return math.atan2(e1x * e2y - e1y * e2x, e1x * e2x + e1y * e2y), e1x, e1y, e2x, e2y
+    return x[i, 0] - x[p, 0], x[i, 1] - x[p, 1], x[q, 0] - x[i, 0], x[q, 1] - x[i, 1]
+
+
+@kernel(inline="always")
+def turning_of(e1x, e1y, e2x, e2y):
+    """Turning angle (rad) from edge ``e1`` to edge ``e2``, in (-pi, pi]."""
+    return math.atan2(e1x * e2y - e1y * e2x, e1x * e2x + e1y * e2y)
+
+
+@kernel
+def _turning_angle(x, i, n):
+    e1x, e1y, e2x, e2y = _edges(x, i, n)
+    return turning_of(e1x, e1y, e2x, e2y), e1x, e1y, e2x, e2y
 
 
 @kernel
