@@ -176,6 +176,10 @@ def main(argv: Sequence[str] | None = None) -> None:
     env_kwargs = dict(args.env_kwargs or {})
     if args.env_kwargs is None and args.policy not in ("random", "heuristic"):
         env_kwargs = _run_env_kwargs(args.policy)
+    elif args.env_kwargs is None:  # a baseline: on the task the agents of its mode train on
+        from .train import task_env_kwargs
+
+        env_kwargs = task_env_kwargs("ppo", args.action_mode or "pressure")
     if args.action_mode:
         env_kwargs["action_mode"] = args.action_mode
     try:

@@ -34,6 +34,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .evaluate import Score, evaluate, parse_env_kwargs
+from .train import task_env_kwargs
 
 RESAMPLES = 2000
 
@@ -165,7 +166,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     if args.env_kwargs:
         args.train_args += ["--env-kwargs", json.dumps(args.env_kwargs)]
     runs = [train_seed(args, seed) for seed in args.seeds]
-    mode = {**args.env_kwargs, "action_mode": args.action_mode}
+    mode = task_env_kwargs(args.algo, args.action_mode, args.env_kwargs)  # the YAML's env_kwargs too
     trained = [heldout_score(args, run, mode) for run in runs]
     baselines = [
         summarise(name, [evaluate(name, mode, args.episodes, progress=True)])

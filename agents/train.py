@@ -95,6 +95,16 @@ def load_hyperparams(algo: str, mode: str) -> dict[str, Any]:
     return dict(table[ENV_IDS[mode]])
 
 
+def task_env_kwargs(algo: str, mode: str, extra: dict[str, Any] | None = None) -> dict[str, Any]:
+    """The env keywords of the task ``algo`` trains on in action mode ``mode``: the YAML entry's
+    ``env_kwargs``, updated with ``extra`` (a command line's ``--env-kwargs``), and the mode. What
+    the training envs get, and what every policy compared with the trained one is scored on."""
+    env_kwargs = dict(load_hyperparams(algo, mode).get("env_kwargs") or {})
+    env_kwargs.update(extra or {})
+    env_kwargs["action_mode"] = mode
+    return env_kwargs
+
+
 def run_folder(log_dir: str | os.PathLike[str], algo: str, mode: str, seed: int) -> pathlib.Path:
     base = pathlib.Path(log_dir) / f"{algo}_{mode}_seed{seed}"
     path, k = base, 1
@@ -262,9 +272,7 @@ def train(args: argparse.Namespace, on_evaluation: OnEvaluation | None = None) -
 
     hp = load_hyperparams(args.algo, args.action_mode)
     hp.update(args.hyperparams or {})
-    env_kwargs = dict(hp.get("env_kwargs") or {})
-    env_kwargs.update(args.env_kwargs or {})
-    env_kwargs["action_mode"] = args.action_mode
+    env_kwargs = {**(hp.get("env_kwargs") or {}), **(args.env_kwargs or {}), "action_mode": args.action_mode}
     n_envs = args.n_envs or int(hp.get("n_envs", 1))
     total = args.total_timesteps or int(hp["n_timesteps"])
     normalize = bool(hp.get("normalize", True))

@@ -33,6 +33,7 @@ if TYPE_CHECKING:
 
 from .baselines import HEURISTIC_PARAMS, HeuristicPolicy, heuristic_table
 from .evaluate import evaluate
+from .train import task_env_kwargs
 
 # name -> (low, high, log scale) of each controller parameter
 HEURISTIC_SPACE = {
@@ -46,8 +47,11 @@ HEURISTIC_SPACE = {
 }
 
 
-def heuristic_objective(mode: str, episodes: int) -> Callable[[optuna.Trial], float]:
-    """Optuna objective: mean apex error of the controller with a trial's parameters."""
+def heuristic_objective(
+    mode: str, episodes: int, env_kwargs: dict[str, Any]
+) -> Callable[[optuna.Trial], float]:
+    """Optuna objective: mean apex error of the controller with a trial's parameters on the env of
+    ``env_kwargs``."""
 
     def objective(trial: optuna.Trial) -> float:
         params = {
@@ -55,7 +59,7 @@ def heuristic_objective(mode: str, episodes: int) -> Callable[[optuna.Trial], fl
             for name, (low, high, log) in HEURISTIC_SPACE[mode].items()
         }
         score = evaluate(
-            lambda env: HeuristicPolicy(env, params), {"action_mode": mode}, episodes, seed=0
+            lambda env: HeuristicPolicy(env, params), env_kwargs, episodes, seed=0
         )  # fmt: skip
         trial.set_user_attr("success_rate", score.success_rate)
         return score.apex_error
@@ -67,7 +71,8 @@ def tune_heuristic(args: argparse.Namespace) -> optuna.Study:
     import optuna
 
     study = optuna.create_study(direction="minimize", sampler=optuna.samplers.TPESampler(seed=args.seed))
-    study.optimize(heuristic_objective(args.action_mode, args.episodes), n_trials=args.trials)
+    env_kwargs = task_env_kwargs("ppo", args.action_mode)  # the task the agents train on
+    study.optimize(heuristic_objective(args.action_mode, args.episodes, env_kwargs), n_trials=args.trials)
     best = {k: round(float(v), 4) for k, v in study.best_params.items()}
     print(f"best apex error {study.best_value:.4f} over {args.episodes} training episodes: {best}")
     if not args.dry_run:

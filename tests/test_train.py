@@ -100,3 +100,24 @@ def test_a_failed_setup_leaves_no_run_folder(tmp_path):
     with pytest.raises(AssertionError, match="batch_size"):
         train(parse_args(["--hyperparams", '{"n_steps": 1, "batch_size": 1}', *quick]))
     assert [p.name for p in runs.iterdir()] == ["ppo_pressure_seed0"]
+
+
+def test_the_task_env_keywords_come_from_the_yaml_and_baselines_are_scored_on_them(monkeypatch):
+    import agents.evaluate
+    import agents.train
+
+    entry = {"env_kwargs": {"fidelity": "balanced", "reward_margin": 0.1}}
+    monkeypatch.setattr(agents.train, "load_hyperparams", lambda algo, mode: entry)
+    assert agents.train.task_env_kwargs("ppo", "paddle", {"reward_margin": 0.2}) == {
+        "fidelity": "balanced", "reward_margin": 0.2, "action_mode": "paddle",
+    }  # fmt: skip
+    seen = []
+
+    def record(policy, env_kwargs, *args, **kwargs):
+        seen.append(dict(env_kwargs))
+        raise SystemExit(0)
+
+    monkeypatch.setattr(agents.evaluate, "evaluate", record)
+    with pytest.raises(SystemExit):
+        main(["heuristic", "--action-mode", "paddle"])
+    assert seen == [{"fidelity": "balanced", "reward_margin": 0.1, "action_mode": "paddle"}]
