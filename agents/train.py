@@ -250,6 +250,35 @@ def check_hyperparams(cls: type[BaseAlgorithm], algo_kwargs: Mapping[str, Any]) 
         )
 
 
+class LinearSchedule:
+    """RL Baselines3 Zoo's ``lin_<value>``: ``value`` times the fraction of the training left
+    (Stable-Baselines3's ``progress_remaining``, 1 at the start, 0 at the end)."""
+
+    def __init__(self, value: float) -> None:
+        self.value = value
+
+    def __call__(self, progress_remaining: float) -> float:
+        return progress_remaining * self.value
+
+
+def schedules(algo_kwargs: Mapping[str, Any]) -> dict[str, Any]:
+    """``algo_kwargs`` with RL Zoo's ``lin_<value>`` strings (``learning_rate``, ``clip_range``) as
+    :class:`LinearSchedule`; a malformed one is a :class:`UsageError` naming it."""
+    out = dict(algo_kwargs)
+    for key in ("learning_rate", "clip_range"):
+        value = out.get(key)
+        if isinstance(value, str):
+            head, _, number = value.partition("_")
+            try:
+                if head != "lin":
+                    raise ValueError(head)
+                out[key] = LinearSchedule(float(number))
+            except ValueError:
+                message = f"{key} = {value!r}: must be a number or 'lin_<number>' (e.g. lin_3e-4)"
+                raise UsageError(message) from None
+    return out
+
+
 def main(argv: Sequence[str] | None = None) -> None:
     """``python train.py ...`` / ``ballenv-train ...``: train, save and score (see the module doc)."""
     try:
@@ -277,10 +306,11 @@ def train(args: argparse.Namespace, on_evaluation: OnEvaluation | None = None) -
     total = args.total_timesteps or int(hp["n_timesteps"])
     normalize = bool(hp.get("normalize", True))
     wrapper = hp.get("env_wrapper")
-    algo_kwargs = {k: v for k, v in hp.items() if k not in RUN_KEYS}
+    algo_kwargs = {k: v for k, v in hp.items() if k not in RUN_KEYS}  # as written (config.yml)
     classes: dict[str, type[PPO] | type[SAC]] = {"ppo": PPO, "sac": SAC}
     cls = classes[args.algo]
     check_hyperparams(cls, algo_kwargs)
+    model_kwargs = schedules(algo_kwargs)
     try:
         wrapper_class(wrapper)
     except ValueError as err:
@@ -313,7 +343,7 @@ def train(args: argparse.Namespace, on_evaluation: OnEvaluation | None = None) -
         opened.callback(eval_env.close)
         model = cls(
             config["policy"], envs, seed=args.seed, tensorboard_log=str(run / "tensorboard"), device="cpu",
-            verbose=0, **algo_kwargs,
+            verbose=0, **model_kwargs,
         )  # fmt: skip
         opened.pop_all()  # set up: the envs stay open for the training
     start = time.perf_counter()

@@ -121,3 +121,16 @@ def test_the_task_env_keywords_come_from_the_yaml_and_baselines_are_scored_on_th
     with pytest.raises(SystemExit):
         main(["heuristic", "--action-mode", "paddle"])
     assert seen == [{"fidelity": "balanced", "reward_margin": 0.1, "action_mode": "paddle"}]
+
+
+def test_rl_zoo_linear_schedules_are_read_and_a_malformed_one_is_named():
+    from agents.train import UsageError, schedules
+
+    out = schedules({"learning_rate": "lin_3e-4", "clip_range": 0.2, "gamma": 0.99})
+    assert out["learning_rate"](1.0) == pytest.approx(3e-4)
+    assert out["learning_rate"](0.25) == pytest.approx(7.5e-5)
+    assert out["clip_range"] == 0.2 and out["gamma"] == 0.99
+    with pytest.raises(UsageError, match="learning_rate = 'exp_3e-4'"):
+        schedules({"learning_rate": "exp_3e-4"})
+    with pytest.raises(UsageError, match="clip_range = 'lin_x'"):
+        schedules({"clip_range": "lin_x"})
