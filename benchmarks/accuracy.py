@@ -6,11 +6,11 @@ the same balls.
     python benchmarks/accuracy.py --quick  # two tolerances, the references from the cache
 
 Error: the first-apex height of the centre of mass, relative to the ball's converged reference
-(fixed-step generalized-alpha at ``ball_family.REFERENCE_DT``, its own error estimated against half
-that step). The references are cached in ``benchmarks/results/accuracy_references.json``
-(``--references`` recomputes them: about 10 minutes). Cost: wall time (median of three runs, numba
-warm), accepted and rejected steps. All runs: generalized-alpha, ``rho_infinity`` = 0.9, adaptive,
-largest step 10 ms, N = 64.
+(``ball_family.reference_apex``: the contact impulse per step at most 5e-5 ``M sqrt(g R)``, its own
+error estimated against twice that). The references are cached in
+``benchmarks/results/accuracy_references.json`` (``--references`` recomputes them: about 6
+minutes). Cost: wall time (median of three runs, numba warm), accepted and rejected steps. All
+runs: generalized-alpha, ``rho_infinity`` = 0.9, adaptive, largest step 10 ms, N = 64.
 """
 
 import os
@@ -24,7 +24,7 @@ import pathlib  # noqa: E402
 import statistics  # noqa: E402
 import time  # noqa: E402
 
-from ball_family import BALLS, REFERENCE_DT, ball_scene, first_apex, gas_to_bending  # noqa: E402
+from ball_family import BALLS, ball_scene, first_apex, gas_to_bending, reference_apex  # noqa: E402
 
 from ballenv.physics import SimulationError  # noqa: E402
 from ballenv.physics.presets import FIDELITY_PRESETS, with_fidelity  # noqa: E402
@@ -36,14 +36,13 @@ NUMERICS = dict(adaptive=True, dt=1e-2, rho_infinity=0.9)
 
 
 def references(recompute=False):
-    """ball -> {"apex": reference first apex (m), "uncertainty": relative change against 2x its step}."""
+    """ball -> {"apex": reference first apex (m), "uncertainty": relative change at twice its tolerance}."""
     if REFERENCES.exists() and not recompute:
         return json.loads(REFERENCES.read_text())
     refs = {}
     for name in BALLS:
-        fine = first_apex(name, ball_scene(name, dt=REFERENCE_DT, rho_infinity=0.9))[0]
-        coarse = first_apex(name, ball_scene(name, dt=2 * REFERENCE_DT, rho_infinity=0.9))[0]
-        refs[name] = {"apex": fine, "uncertainty": abs(coarse - fine) / fine}
+        fine, uncertainty = reference_apex(name)
+        refs[name] = {"apex": fine, "uncertainty": uncertainty}
         print(f"reference {name}: {fine:.6f} m (+- {refs[name]['uncertainty']:.1e})", flush=True)
     REFERENCES.write_text(json.dumps(refs, indent=1) + "\n")
     return refs

@@ -121,3 +121,32 @@ def test_error_control_costs_nothing_without_it():
     scene = ball_family.ball_scene("env", n_nodes=16, adaptive=True, dt=1e-2, impulse_tol=1e-3)
     traj = simulate(scene, t_end=0.3)
     assert traj.stats.rejections["error"] == 0
+
+
+@pytest.mark.parametrize("name", ["tennis", "env"])
+def test_contact_bound_sets_the_first_apex(name):
+    """Under ``rtol`` the contact bound ``rtol M sqrt(g R)`` sets the steps in contact, where the first
+    apex is decided; the local error estimate adds flight steps only (the centre of mass is ballistic
+    there): the first apex with both criteria equals the one with the contact bound alone
+    (``impulse_tol``, ``rtol`` = 0) to 1e-4 relative (measured: 4e-8 on tennis, 4e-6 on env), while
+    both take more steps."""
+    rtol = 3e-2
+    numerics = dict(adaptive=True, dt=1e-2, rho_infinity=0.9)
+    both, traj_both = ball_family.first_apex(name, ball_family.ball_scene(name, rtol=rtol, **numerics))
+    bound = rtol * ball_family.momentum_scale(name)
+    alone, traj_alone = ball_family.first_apex(
+        name, ball_family.ball_scene(name, impulse_tol=bound, **numerics)
+    )
+    assert both == pytest.approx(alone, rel=1e-4)
+    assert traj_both.stats.rejections["error"] > 0 and traj_alone.stats.rejections["error"] == 0
+    assert traj_both.stats.steps > traj_alone.stats.steps
+
+
+def test_reference_bound_is_relative_to_the_ball():
+    """The family's references bound the contact impulse per step by ``tol M sqrt(g R)`` (N s)."""
+    for name in ("bending", "basketball"):
+        ring = ball_family.ball_scene(name).rings[0]
+        scene = ball_family.reference_scene(name)
+        expected = ball_family.REFERENCE_TOL * total_mass(ring) * math.sqrt(9.81 * ring.radius)
+        assert scene.impulse_tol == pytest.approx(expected, rel=1e-12)
+        assert scene.rtol == 0.0 and scene.adaptive and scene.dt == ball_family.REFERENCE_DT
