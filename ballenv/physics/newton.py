@@ -51,6 +51,7 @@ from .wall_limits import limit_fraction, wall_limit_force, wall_limit_jacobian
 MAX_CONTACT_SET_CHANGES = 64
 PLAIN = 0  # Workspace.barrier.mode[0]: the step without the self-contact barrier
 SAFE = 1  # with it, every correction filtered by continuous collision detection
+COUPLED = 1  # Workspace.ring_contact.mode[0]: rings in contact solved jointly (else 0: one by one)
 MIN_NEWTON_FRACTION = 1.0 / 32.0  # backtracking halves a correction at most 5 times
 FAILED = -1
 
@@ -67,6 +68,7 @@ def residual(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active):
     if model.self_barrier:
         add_barrier_force(model, r, ws, ws.barrier)
         add_limit_force(model, r, ws, ws.barrier)
+        add_ring_contact_force(r, ws, ws.ring_contact)
     res = ws.res
     f = ws.force
     scale = 0.0
@@ -213,6 +215,20 @@ def _cut_at_impact(model, r, xa, bw):
         return 1.0
     first = impact_fraction(xa, bw.xn, bw.pairs, count)
     return CCD_SAFETY * first if first <= 1.0 else 1.0
+
+
+@kernel
+def add_ring_contact_force(r, ws, rc):
+    """In the joint step of rings in contact (``rc.mode[0] == COUPLED``), add ring ``r``'s share of
+    the contact force between rings (``rc.force[r]``, N: :mod:`.ring_newton`) to ``ws.force``."""
+    if rc is None:
+        return
+    if rc.mode[0] != COUPLED:
+        return
+    f = ws.force
+    for i in range(f.shape[0]):
+        for d in range(2):
+            f[i, d] += rc.force[r, i, d]
 
 
 @kernel

@@ -273,6 +273,7 @@ class Simulation:
             effects,
             barrier=self.model.self_barrier,
             ring_pairs=self.model.collide,
+            ring_contact=self.model.ring_barrier,
             n_grounds=len(scene.grounds) + len(scene.drums),
         )
         self.state = empty_state(n_rings, n_nodes)
