@@ -23,8 +23,6 @@ from .assembly import (
 )
 from .barrier import PAIRS_PER_NODE
 from .collision import CONTACT_COLUMNS, CONTACTS_PER_NODE
-from .ring_contact import ENTRIES_PER_PAIR, PAIR_COLUMNS
-from .ring_contact import PAIRS_PER_NODE as RING_PAIRS_PER_NODE
 from .effects import EFFECTS
 from .effects.damping import DAMPING_CENTRE_OF_MASS, DAMPING_NONE, DAMPING_RIGID
 from .ground_motion import ground_array, grounds_move, surface_array
@@ -38,6 +36,8 @@ from .layout import (
     TALLY,
 )
 from .linalg import BAND_COLUMNS, MAX_LOW_RANK, SOLVE_COLUMNS, zigzag_positions
+from .ring_contact import ENTRIES_PER_PAIR, PAIR_COLUMNS
+from .ring_contact import PAIRS_PER_NODE as RING_PAIRS_PER_NODE
 
 CONTACT_NONE = 0
 CONTACT_MASS_MODIFICATION = 1
@@ -337,8 +337,9 @@ def build_workspace(
     the collision scratch once more as ``Workspace.ring_pairs`` (the ring-ring code's), or None
     for a model whose rings cannot collide; ``ring_contact``: the joint step's scratch of rings in
     contact through the barrier (needs ``barrier``), else None. A step compiled with None in any of
-    these places holds none of that code (numba prunes ``if ... is None`` on an argument before typing). ``n_grounds``: at
-    least the model's number of grounds, for the rows of the grounds at the step's times."""
+    these places holds none of that code (numba prunes ``if ... is None`` on an argument before
+    typing). ``n_grounds``: at least the model's number of grounds, for the rows of the grounds at
+    the step's times."""
     n2 = 2 * n_nodes
     collision = build_collision_workspace(n_rings, n_nodes)
     return Workspace(

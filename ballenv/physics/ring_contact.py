@@ -31,7 +31,14 @@ of every node) a node of one ring meets an edge of another (:func:`barrier.point
 
 import math
 
-from .barrier import beta, beta_curvature, beta_slope, point_edge_derivatives, point_edge_distance2, point_edge_impact
+from .barrier import (
+    beta,
+    beta_curvature,
+    beta_slope,
+    point_edge_derivatives,
+    point_edge_distance2,
+    point_edge_impact,
+)
 from .collision import overlapping_pairs
 from .cyclic import next_node
 from .jit import kernel
@@ -207,7 +214,9 @@ def contact_force(model, x, pairs, count, f, rw):
             f[a, i, 0] += math.inf
             continue
         active += 1
-        point_edge_derivatives(x[a, i, 0], x[a, i, 1], x[b, j, 0], x[b, j, 1], x[b, q, 0], x[b, q, 1], rw.g, rw.hess, rw.scratch)
+        point_edge_derivatives(
+            x[a, i, 0], x[a, i, 1], x[b, j, 0], x[b, j, 1], x[b, q, 0], x[b, q, 1], rw.g, rw.hess, rw.scratch
+        )
         slope = pair_stiffness(model, a, b) * beta_slope(s / dhat2)
         for d in range(2):
             f[a, i, d] -= slope * rw.g[d]
@@ -231,7 +240,9 @@ def pair_hessians(model, x, pairs, count, coef, rw):
         rw.within[c] = s < dhat2 and s > 0.0
         if not rw.within[c]:
             continue
-        point_edge_derivatives(x[a, i, 0], x[a, i, 1], x[b, j, 0], x[b, j, 1], x[b, q, 0], x[b, q, 1], rw.g, rw.hess, rw.scratch)
+        point_edge_derivatives(
+            x[a, i, 0], x[a, i, 1], x[b, j, 0], x[b, j, 1], x[b, q, 0], x[b, q, 1], rw.g, rw.hess, rw.scratch
+        )
         kappa = pair_stiffness(model, a, b)
         ca = coef * kappa * beta_curvature(s / dhat2) / dhat2
         cb = coef * kappa * beta_slope(s / dhat2)
@@ -265,7 +276,16 @@ def add_ring_blocks(pairs, count, r, n, band, pos, rw):
                 if ra != r or rb != r:
                     continue
                 h = rw.hessians[c]
-                band_add_block(band, pos, na, nb, h[2 * ka, 2 * kb], h[2 * ka, 2 * kb + 1], h[2 * ka + 1, 2 * kb], h[2 * ka + 1, 2 * kb + 1])
+                band_add_block(
+                    band,
+                    pos,
+                    na,
+                    nb,
+                    h[2 * ka, 2 * kb],
+                    h[2 * ka, 2 * kb + 1],
+                    h[2 * ka + 1, 2 * kb],
+                    h[2 * ka + 1, 2 * kb + 1],
+                )
 
 
 @kernel

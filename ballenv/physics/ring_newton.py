@@ -36,7 +36,13 @@ import math
 
 from .assembly import ring_jacobian
 from .barrier import CCD_SAFETY, find_pairs, reach
-from .contact import PENETRATION_TOLERANCE, activate_penetrating, constrain_jacobian, constrain_low_rank_rows, rest_on_grounds
+from .contact import (
+    PENETRATION_TOLERANCE,
+    activate_penetrating,
+    constrain_jacobian,
+    constrain_low_rank_rows,
+    rest_on_grounds,
+)
 from .integrator import coefficients, kinematics, predict
 from .jit import copy_into, kernel
 from .layout import ENERGY_TOTAL
@@ -205,7 +211,9 @@ def ring_columns(model, solver, r, state, v0, trial, h, ws, rc):
         )  # fmt: skip
         if wide > rank:
             constrain_barrier_rows(model, active, x1, ws, rank, wide, bw)
-        constrain_low_rank_rows(ws.surface, active, x1, ws.ve, rc.cols, 1, n_cols, model.friction_regularization)
+        constrain_low_rank_rows(
+            ws.surface, active, x1, ws.ve, rc.cols, 1, n_cols, model.friction_regularization
+        )
     u, w = ws.u, ws.w
     if wide > rank:
         for k in range(ws.res.shape[0]):
