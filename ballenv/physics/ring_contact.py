@@ -198,6 +198,17 @@ def contact_energy(model, x, pairs, count):
 
 
 @kernel
+def contact_energy_by_ring(model, x, rw, out):
+    """Add the barrier energy (J) between the rings at ``x`` (R, N, 2) m to ``out`` (R,), each pair's
+    half to either of its rings."""
+    count = find_ring_pairs(model, x, x, rw)
+    for c in range(max(count, 0)):
+        e = contact_energy(model, x, rw.pairs[c : c + 1], 1)
+        out[rw.pairs[c, 0]] += 0.5 * e
+        out[rw.pairs[c, 2]] += 0.5 * e
+
+
+@kernel
 def contact_force(model, x, pairs, count, f, rw):
     """Add ``-grad E`` (N) of the candidate ``pairs`` at ``x`` (R, N, 2) m to ``f`` (R, N, 2); a
     pair at distance 0 adds inf. Returns the number of pairs within ``dhat``."""
