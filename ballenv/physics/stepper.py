@@ -293,11 +293,18 @@ def try_step(model, solver, state, trial, t, h, ws):
     ``(1 - alpha_m) / beta`` for generalized-alpha (whose Newmark update reflects the node's normal
     velocity before :func:`contact.rest_on_grounds` removes it).
 
-    With ring collision, the collision impulses are found on the predicted positions ``x0 + h v0``
-    and added to the start velocities (``collision.py``); each ring's energy guard and energy budget
-    are credited with the change of its kinetic energy by them. Their sum over rings is negative
-    (energy lost) except where they push out nodes that start the step inside the contact distance
-    (a Baumgarte-type term): that net gain is tallied in ``ws.energy_tally``. They are not part of
+    With ring collision through the barrier (``model.ring_barrier``, ``ws.ring_contact``), a step
+    whose start has a node within the contact distance of another ring, or that, solved ring by
+    ring, ends within it or passes a node through a wall on the way
+    (:func:`ring_newton.rings_touch`, :func:`ring_newton.rings_met`), is solved for all rings at once
+    (:func:`joint_step`); each ring's energy budget is credited with what the contact moved to it
+    (:func:`ring_newton.contact_transfers`, summing to minus the change of the contact energy).
+    Otherwise, with ring collision, the collision impulses are found on the predicted positions
+    ``x0 + h v0`` and added to the start velocities (``collision.py``); each ring's energy guard
+    and energy budget are credited with the change of its kinetic energy by them. Their sum over
+    rings is negative (energy lost) except where they push out nodes that start the step inside the
+    contact distance (a Baumgarte-type term): that net gain is tallied in ``ws.energy_tally``. They
+    are not part of
     the contact impulse (the part that stops an approaching node does not shrink with the step).
     """
     total = 0
