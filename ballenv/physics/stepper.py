@@ -304,8 +304,8 @@ def try_step(model, solver, state, trial, t, h, ws):
     and energy budget are credited with the change of its kinetic energy by them. Their sum over
     rings is negative (energy lost) except where they push out nodes that start the step inside the
     contact distance (a Baumgarte-type term): that net gain is tallied in ``ws.energy_tally``. They
-    are not part of
-    the contact impulse (the part that stops an approaching node does not shrink with the step).
+    are not part of the contact impulse (the part that stops an approaching node does not shrink
+    with the step).
     """
     total = 0
     impulse_ratio = math.inf
