@@ -134,6 +134,27 @@ def test_continuous_detection_catches_a_thin_wall_crossing_the_end_states_miss()
 
 
 # ------------------------------------------------------------------------------- the scenes
+def test_only_barrier_scenes_with_colliding_rings_hold_the_joint_step():
+    ring = Ring()
+    assert Simulation(Scene(rings=[ring])).ws.ring_contact is None  # one ring (and the env)
+    two = [ring, Ring(position=(1.0, 0.0))]
+    assert Simulation(Scene(rings=two, self_intersection="reject")).ws.ring_contact is None
+    assert Simulation(Scene(rings=two, ring_collision=False)).ws.ring_contact is None
+    assert Simulation(Scene(rings=two)).ws.ring_contact is not None
+
+
+@pytest.mark.parametrize("integrator", ["generalized_alpha", "backward_euler"])
+def test_thirty_metres_per_second_head_on_stays_clear_of_the_other_wall(integrator):
+    rings, x0, v0, _ = mirrored_pair(32, 15.0, gap=0.2)  # 30 m/s closing speed, 10 ms largest step
+    scene = Scene(rings=rings, gravity=0.0, dt=1e-2, adaptive=True, integrator=integrator)
+    traj = simulate(scene, 0.03, x0=x0, v0=v0)  # every accepted state recorded
+    assert closest(scene, traj) > 0.5  # of the contact distance; measured 0.81 and 0.86
+    assert traj.v[-1, 0, :, 0].mean() < -10.0  # bounced (measured -11.6 and -11.2 m/s)
+    energy = traj.energy()["total"].sum(axis=1)
+    assert energy.max() <= energy[0] + 1e-12 * abs(energy[0])
+    assert sum(traj.stats.rejections.values()) == 0
+
+
 @pytest.mark.parametrize("integrator", ["generalized_alpha", "backward_euler"])
 def test_head_on_collision_through_the_barrier(integrator):
     rings, x0, v0, mirror = mirrored_pair(32, 3.0)
