@@ -329,14 +329,16 @@ def build_drive(n_rings, n_nodes):
 
 
 def build_workspace(
-    n_nodes, n_rings=1, effects=EFFECTS, barrier=True, ring_pairs=True, n_grounds=1, ring_contact=False
-):
+    n_nodes, n_rings=1, effects=EFFECTS, barrier=True, ring_pairs=True, n_grounds=1, ring_contact=False,
+    contact_pairs_per_node=RING_PAIRS_PER_NODE,
+):  # fmt: skip
     """Scratch arrays for one ring's Newton solve and the scene's collision detection, allocated
     once per simulation (``effects``: the model's, for the size of the energy table). ``barrier``:
     the self-contact barrier's scratch, or None in its place for a model without it; ``ring_pairs``:
     the collision scratch once more as ``Workspace.ring_pairs`` (the ring-ring code's), or None
     for a model whose rings cannot collide; ``ring_contact``: the joint step's scratch of rings in
-    contact through the barrier (needs ``barrier``), else None. A step compiled with None in any of
+    contact through the barrier (needs ``barrier``; ``contact_pairs_per_node``: its room for
+    candidate pairs, :func:`ring_contact.pairs_per_node`), else None. A step compiled with None in any of
     these places holds none of that code (numba prunes ``if ... is None`` on an argument before
     typing). ``n_grounds``: at least the model's number of grounds, for the rows of the grounds at
     the step's times."""
@@ -367,17 +369,22 @@ def build_workspace(
         collision=collision,
         barrier=build_barrier_workspace(n_nodes) if barrier else None,
         ring_pairs=collision if ring_pairs else None,
-        ring_contact=build_ring_contact_workspace(n_rings, n_nodes) if ring_contact and barrier else None,
+        ring_contact=(
+            build_ring_contact_workspace(n_rings, n_nodes, contact_pairs_per_node)
+            if ring_contact and barrier
+            else None
+        ),
     )
 
 
 MAX_COUPLING_COLUMNS = 1024  # largest joint capacitance (two columns per node coupled across rings)
 
 
-def build_ring_contact_workspace(n_rings, n_nodes):
-    """Scratch of the joint step of ``n_rings`` rings of ``n_nodes`` nodes in contact."""
+def build_ring_contact_workspace(n_rings, n_nodes, pairs_per_node=RING_PAIRS_PER_NODE):
+    """Scratch of the joint step of ``n_rings`` rings of ``n_nodes`` nodes in contact, with room
+    for ``pairs_per_node`` candidate pairs per node."""
     n2 = 2 * n_nodes
-    pairs = RING_PAIRS_PER_NODE * n_rings * n_nodes
+    pairs = pairs_per_node * n_rings * n_nodes
     entries = ENTRIES_PER_PAIR * pairs
     k = MAX_LOW_RANK + n2
     c = min(n_rings * n2, MAX_COUPLING_COLUMNS)

@@ -45,8 +45,18 @@ from .jit import kernel
 from .linalg import band_add_block
 
 PAIR_COLUMNS = 4  # a pair's row: ring a, node i of a, ring b, edge j of b (nodes j, j + 1)
-PAIRS_PER_NODE = 8  # room for candidate pairs per node of the scene
+PAIRS_PER_NODE = 8  # least room for candidate pairs per node of the scene (pairs_per_node)
 ENTRIES_PER_PAIR = 16  # off-ring Hessian entries a pair adds: 8 in node i's rows, 4 in each edge end's
+
+
+def pairs_per_node(model) -> int:
+    """Room for candidate pairs per node of a scene (``Model``): a node within ``dhat`` of another
+    ring's wall of edges ``l_0`` long faces up to ``2 dhat / l_0 + 2`` of them; twice that (two
+    walls, or a node near a corner) plus slack, at least ``PAIRS_PER_NODE``. Walls thick against
+    their edges (``dhat`` = 21 edges: N = 256 rings with h = 68 mm) need more than the default."""
+    reach = 2.0 * float(model.thickness.max())
+    edge = float(model.rest_len.min())
+    return max(PAIRS_PER_NODE, 2 * math.ceil(2.0 * reach / edge) + 4)
 
 
 @kernel(inline="always")

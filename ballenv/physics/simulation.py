@@ -85,7 +85,7 @@ from .model import (
     empty_recording,
     empty_state,
 )
-from .ring_contact import contact_energy_by_ring
+from .ring_contact import contact_energy_by_ring, pairs_per_node
 from .scene import Scene, check_gauge_pressure, check_real, check_vector
 from .stepper import advance, initial_state_values, record
 
@@ -230,7 +230,7 @@ def energy(scene: Scene, x: ArrayLike, v: ArrayLike) -> dict[str, NDArray[np.flo
 def _contact_energy_by_ring(model, states):
     """(T, R): the barrier energy (J) between rings of each state (T, R, N, 2), each pair's half to
     either ring."""
-    rw = build_ring_contact_workspace(states.shape[1], states.shape[2])
+    rw = build_ring_contact_workspace(states.shape[1], states.shape[2], pairs_per_node(model))
     out = np.zeros(states.shape[:2])
     for k, x in enumerate(states):
         x = np.ascontiguousarray(x)
@@ -293,6 +293,7 @@ class Simulation:
             barrier=self.model.self_barrier,
             ring_pairs=self.model.collide,
             ring_contact=self.model.ring_barrier,
+            contact_pairs_per_node=pairs_per_node(self.model),
             n_grounds=len(scene.grounds) + len(scene.drums),
         )
         self.state = empty_state(n_rings, n_nodes)
