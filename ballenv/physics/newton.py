@@ -68,7 +68,6 @@ def residual(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active):
     if model.self_barrier:
         add_barrier_force(model, r, ws, ws.barrier)
         add_limit_force(model, r, ws, ws.barrier)
-        add_ring_contact_force(r, ws, ws.ring_contact)
     res = ws.res
     f = ws.force
     scale = 0.0
@@ -270,11 +269,13 @@ def limit_filter(c_x, xe, x1, step, bw):
 @kernel
 def add_barrier_force(model, r, ws, bw):
     """In safe mode, add the self-contact barrier's force at the force evaluation point ``ws.xe``
-    (on the candidate pairs of the last correction's motion) to ``ws.force``."""
+    (on the candidate pairs of the last correction's motion) to ``ws.force``; in the joint step of
+    rings in contact, their contact force too (:func:`add_ring_contact_force`)."""
     if bw is None:
         return
     if bw.mode[0] == SAFE and bw.n_pairs[0] > 0:
         barrier_force(ws.xe, bw.pairs, bw.n_pairs[0], stiffness(model, r), reach(model, r), ws.force, bw)
+    add_ring_contact_force(r, ws, ws.ring_contact)
 
 
 @kernel

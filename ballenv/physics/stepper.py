@@ -180,13 +180,38 @@ def joint_energy(model, state, trial, ws, rc):
 
 
 @kernel
-def joint_step(model, solver, state, v0, trial, h, ws, rc):
+def step_rings(model, solver, state, v0, trial, h, ws, rc):
+    """The trial step of every ring: returns (Newton corrections, impulse ratio, local error) as
+    :func:`try_step`, a rejection as ``(-code, 0, 0)``. Ring by ring (:func:`step_ring`,
+    :func:`ring_rates`); with ``rc`` (rings that collide through the barrier), all rings jointly
+    (:func:`joint_rings_step`) if a node starts within the contact distance of another ring
+    (:func:`ring_newton.rings_touch`) or the step solved ring by ring met another ring on the way
+    or at its end (:func:`ring_newton.rings_met`). A compiled call: numba prunes the joint step for
+    ``rc`` None before it inlines or types any of it, so the env and every scene without it compile
+    the ring-by-ring loop only."""
+    if rc is not None:
+        if rings_touch(model, state.x, rc):
+            return joint_rings_step(model, solver, state, v0, trial, h, ws, rc)
+    total = 0
+    impulse_ratio = math.inf
+    error = 0.0
+    for r in range(state.x.shape[0]):
+        its = step_ring(model, solver, r, state, v0, trial, h, ws)
+        if its < 0:
+            return its, 0.0, 0.0
+        total += its
+        impulse_ratio, error = ring_rates(model, solver, r, state, v0, trial, h, ws, impulse_ratio, error)
+    if rc is not None:
+        if rings_met(model, state.x, trial.x, rc):
+            return joint_rings_step(model, solver, state, v0, trial, h, ws, rc)
+    return total, impulse_ratio, error
+
+
+@kernel
+def joint_rings_step(model, solver, state, v0, trial, h, ws, rc):
     """The trial step of all rings solved jointly with the contact between rings
     (:func:`ring_newton.joint_newton`), then each ring's acceptance tests and step-size limits:
-    returns (Newton corrections, impulse ratio, local error) as :func:`try_step`. Nothing (a
-    Newton failure) without ``rc``."""
-    if rc is None:
-        return -REJECT_NEWTON, 0.0, 0.0
+    returns (Newton corrections, impulse ratio, local error) as :func:`try_step`."""
     rc.mode[0] = COUPLED
     ws.energy_tally[TALLY_BOUNDARY_WORK] = 0.0  # (of a step tried ring by ring first)
     ws.energy_tally[TALLY_PROJECTED] = 0.0
@@ -297,7 +322,7 @@ def try_step(model, solver, state, trial, t, h, ws):
     whose start has a node within the contact distance of another ring, or that, solved ring by
     ring, ends within it or passes a node through a wall on the way
     (:func:`ring_newton.rings_touch`, :func:`ring_newton.rings_met`), is solved for all rings at once
-    (:func:`joint_step`); each ring's energy budget is credited with what the contact moved to it
+    (:func:`step_rings`); each ring's energy budget is credited with what the contact moved to it
     (:func:`ring_newton.contact_transfers`, summing to minus the change of the contact energy).
     Otherwise, with ring collision, the collision impulses are found on the predicted positions
     ``x0 + h v0`` and added to the start velocities (``collision.py``); each ring's energy guard
@@ -307,26 +332,13 @@ def try_step(model, solver, state, trial, t, h, ws):
     are not part of the contact impulse (the part that stops an approaching node does not shrink
     with the step).
     """
-    total = 0
-    impulse_ratio = math.inf
-    error = 0.0
     ws.energy_tally[:] = 0.0
     ground_surfaces(model.grounds, t, ws.surface_start)
     ground_surfaces(model.grounds, t + h, ws.surface)
     v0 = ws.collision.kicked if collision_kicks(model, state, h, ws) else state.v
-    coupled = rings_touch(model, state.x, ws.ring_contact)
-    if not coupled:
-        for r in range(state.x.shape[0]):
-            its = step_ring(model, solver, r, state, v0, trial, h, ws)
-            if its < 0:
-                return its, 0.0, 0.0
-            total += its
-            impulse_ratio, error = ring_rates(model, solver, r, state, v0, trial, h, ws, impulse_ratio, error)
-        coupled = rings_met(model, state.x, trial.x, ws.ring_contact)
-    if coupled:
-        total, impulse_ratio, error = joint_step(model, solver, state, v0, trial, h, ws, ws.ring_contact)
-        if total < 0:
-            return total, 0.0, 0.0
+    total, impulse_ratio, error = step_rings(model, solver, state, v0, trial, h, ws, ws.ring_contact)
+    if total < 0:
+        return total, 0.0, 0.0
     if model.collide and rings_intrude(trial.x, model.thickness, ws.ring_pairs):
         return -REJECT_INTRUSION, 0.0, 0.0
     return total, impulse_ratio, error
