@@ -165,9 +165,9 @@ def test_head_on_collision_through_the_barrier(integrator):
     assert np.abs(momentum.sum(axis=1)).max() <= 1e-12 * one_ball  # measured 1e-15
     assert traj.v[-1, 0, :, 0].mean() < -1.5  # bounced back (measured -2.5 and -2.0 m/s from 3)
     image = traj.x[:, 0][:, mirror] * (-1.0, 1.0)
-    assert np.abs(image - traj.x[:, 1]).max() <= 1e-9
+    assert np.abs(image - traj.x[:, 1]).max() <= 1e-9  # measured 5e-15 and 5e-13 m
     assert no_intrusion(traj.x, np.full(2, rings[0].thickness))
-    assert closest(scene, traj) > 0.5  # measured 0.68 and 0.75 of the contact distance
+    assert closest(scene, traj) > 0.5  # measured 0.956 and 0.964 of the contact distance
     assert traj.stats.collision_gain == 0.0
     parts = traj.energy()
     # counted in the energy: at most 1.8e-3 J (generalized-alpha) and 9e-4 J (backward Euler) in the
