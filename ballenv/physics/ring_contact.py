@@ -30,6 +30,7 @@ of every node) a node of one ring meets an edge of another (:func:`barrier.point
 """
 
 import math
+from typing import TYPE_CHECKING
 
 from .barrier import (
     beta,
@@ -44,12 +45,15 @@ from .cyclic import next_node
 from .jit import kernel
 from .linalg import band_add_block
 
+if TYPE_CHECKING:
+    from .model import Model
+
 PAIR_COLUMNS = 4  # a pair's row: ring a, node i of a, ring b, edge j of b (nodes j, j + 1)
 PAIRS_PER_NODE = 8  # least room for candidate pairs per node of the scene (pairs_per_node)
 ENTRIES_PER_PAIR = 16  # off-ring Hessian entries a pair adds: 8 in node i's rows, 4 in each edge end's
 
 
-def pairs_per_node(model) -> int:
+def pairs_per_node(model: "Model") -> int:
     """Room for candidate pairs per node of a scene (``Model``): a node within ``dhat`` of another
     ring's wall of edges ``l_0`` long faces up to ``2 dhat / l_0 + 2`` of them; twice that (two
     walls, or a node near a corner) plus slack, at least ``PAIRS_PER_NODE``. Walls thick against

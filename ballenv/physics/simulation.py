@@ -227,7 +227,7 @@ def energy(scene: Scene, x: ArrayLike, v: ArrayLike) -> dict[str, NDArray[np.flo
     return out
 
 
-def _contact_energy_by_ring(model, states):
+def _contact_energy_by_ring(model: Model, states: NDArray[np.float64]) -> NDArray[np.float64]:
     """(T, R): the barrier energy (J) between rings of each state (T, R, N, 2), each pair's half to
     either ring."""
     rw = build_ring_contact_workspace(states.shape[1], states.shape[2], pairs_per_node(model))
