@@ -40,7 +40,9 @@ N = 32 rings:
       d = -dt v_n + r (delta - s0),   r = 1 if s0 >= delta else min(1, dt / RELAXATION_TIME).
 
 The impulses are computed at the start of the step (explicit), so the rings are still solved one
-by one.
+by one. They act with ``Scene.self_intersection`` ``"reject"`` and ``"ignore"``; with
+``"barrier"``, rings touch through the barrier potential of :mod:`.ring_contact` inside one implicit
+step of the rings in contact (:mod:`.ring_newton`) instead.
 
 Step acceptance (the stepper calls :func:`rings_intrude` on every trial state): a trial state in
 which a node of one ring is inside another ring's centreline is rejected and retried with half the

@@ -259,3 +259,90 @@ def solve_band_wide_low_rank(band, pos, u, v, rank, rhs, work, z, cap, coef):
             s -= z[k, c] * coef[c]
         rhs[k] = s
     return True
+
+
+@kernel
+def lu_factor(a, k, piv):
+    """Factorise ``a[:k, :k]`` in place (LU with partial pivoting; row swaps in ``piv``). False if
+    singular."""
+    for c in range(k):
+        best = c
+        for r in range(c + 1, k):
+            if abs(a[r, c]) > abs(a[best, c]):
+                best = r
+        piv[c] = best
+        if not (abs(a[best, c]) > 1e-300):
+            return False
+        if best != c:
+            for j in range(k):
+                a[c, j], a[best, j] = a[best, j], a[c, j]
+        inv = 1.0 / a[c, c]
+        for r in range(c + 1, k):
+            f = a[r, c] * inv
+            a[r, c] = f
+            if f != 0.0:
+                for j in range(c + 1, k):
+                    a[r, j] -= f * a[c, j]
+    return True
+
+
+@kernel
+def lu_solve(a, k, piv, b):
+    """Solve with a factor of :func:`lu_factor`: ``b[:k]`` is overwritten by the solution."""
+    for c in range(k):
+        p = piv[c]
+        if p != c:
+            b[c], b[p] = b[p], b[c]
+    for r in range(k):
+        s = b[r]
+        for j in range(r):
+            s -= a[r, j] * b[j]
+        b[r] = s
+    for r in range(k - 1, -1, -1):
+        s = b[r]
+        for j in range(r + 1, k):
+            s -= a[r, j] * b[j]
+        b[r] = s / a[r, r]
+
+
+@kernel
+def solve_band_low_rank_columns(band, pos, u, v, rank, cols, n_cols, work, z, cap, piv, coef):
+    """Solve (B + U V^T) X = C in place of the first ``n_cols`` columns of ``cols`` (2N, >= n_cols;
+    natural order) for ``rank`` low-rank columns ``u``, ``v`` (2N, >= rank): the Woodbury identity
+    with ``Z = B^-1 U``, the capacitance ``I + V^T Z`` factorised once for every column;
+    ``O(N w^2 + N (w + rank) (rank + n_cols) + rank^3)``. ``band`` is overwritten by its LU factor.
+    Scratch: ``work`` (2N, SOLVE_COLUMNS), ``z`` (2N, >= rank), ``cap`` (>= rank, >= rank), ``piv``
+    (>= rank,) int, ``coef`` (>= rank,). Returns False if a factorisation breaks down."""
+    if not band_lu(band):
+        return False
+    n = cols.shape[0]
+    for k in range(n):
+        for c in range(rank):
+            z[k, c] = u[k, c]
+    _solve_columns(band, pos, z, 0, rank, work, z)
+    _solve_columns(band, pos, cols, 0, n_cols, work, cols)
+    if rank == 0:
+        return True
+    for a in range(rank):
+        for c in range(rank):
+            cap[a, c] = 1.0 if a == c else 0.0
+        for k in range(n):
+            va = v[k, a]
+            if va != 0.0:
+                for c in range(rank):
+                    cap[a, c] += va * z[k, c]
+    if not lu_factor(cap, rank, piv):
+        return False
+    for c in range(n_cols):
+        for a in range(rank):
+            s = 0.0
+            for k in range(n):
+                s += v[k, a] * cols[k, c]
+            coef[a] = s
+        lu_solve(cap, rank, piv, coef)
+        for k in range(n):
+            s = cols[k, c]
+            for a in range(rank):
+                s -= z[k, a] * coef[a]
+            cols[k, c] = s
+    return True

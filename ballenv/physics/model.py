@@ -36,6 +36,8 @@ from .layout import (
     TALLY,
 )
 from .linalg import BAND_COLUMNS, MAX_LOW_RANK, SOLVE_COLUMNS, zigzag_positions
+from .ring_contact import ENTRIES_PER_PAIR, PAIR_COLUMNS
+from .ring_contact import PAIRS_PER_NODE as RING_PAIRS_PER_NODE
 
 CONTACT_NONE = 0
 CONTACT_MASS_MODIFICATION = 1
@@ -68,6 +70,7 @@ class Model(NamedTuple):
     collide: bool  # ring-ring collision (two or more rings and Scene.ring_collision)
     reject_self_intersection: bool  # reject trial states in which a ring crosses itself
     self_barrier: bool  # the self-contact barrier of far wall parts (barrier.py)
+    ring_barrier: bool  # rings collide through the barrier, solved jointly (ring_contact.py), not impulses
     effect_parameters: np.ndarray  # (R,) records: one field per effect summed, its own parameters
 
 
@@ -131,6 +134,54 @@ class BarrierWorkspace(NamedTuple):
     clear_key: np.ndarray  # (2,): their rest length and dhat (m); NaN: none found yet
 
 
+class RingContactWorkspace(NamedTuple):
+    """Scratch of the joint Newton step of rings in contact (``ring_contact.py``, ``ring_newton.py``)
+    for R rings of N nodes; ``C`` coupling columns at most, ``P`` candidate pairs."""
+
+    mode: np.ndarray  # (1,) int64: ring_newton.PLAIN (rings one by one) or COUPLED (jointly)
+    pairs: np.ndarray  # (P, PAIR_COLUMNS) int64: ring a, node i, ring b, edge j
+    n_pairs: np.ndarray  # (1,) int64
+    box: np.ndarray  # (R, 4) m: each ring's box over a motion
+    margin: np.ndarray  # (R,) m: its growth in the broad phase (the wall thickness)
+    order: np.ndarray  # (R,) int64: rings by the left edge of their grown box
+    ring_pairs: np.ndarray  # (R (R - 1) / 2, 2) int64: ring pairs of the broad phase
+    near: np.ndarray  # (N,) int64: edges of one ring near another ring's box
+    span: np.ndarray  # (2, 4) m: an edge's and a node's box over a motion
+    g: np.ndarray  # (6,): gradient of a pair's squared distance
+    hess: np.ndarray  # (6, 6): its Hessian
+    scratch: np.ndarray  # (6, 6)
+    hessians: np.ndarray  # (P, 6, 6): c_x hess E of each pair
+    within: np.ndarray  # (P,) bool: the pair is within dhat (its Hessian counts)
+    slot: np.ndarray  # (R, N) int64: first coupling column of a coupled node, or -1
+    first: np.ndarray  # (R + 1,) int64: each ring's first coupling column
+    column: np.ndarray  # (ENTRIES_PER_PAIR P,) int64: an off-ring entry's coupling column
+    ring: np.ndarray  # (ENTRIES_PER_PAIR P,) int64: the ring of its unknown
+    dof: np.ndarray  # (ENTRIES_PER_PAIR P,) int64: the unknown (2 node + component)
+    value: np.ndarray  # (ENTRIES_PER_PAIR P,): its value
+    dx: np.ndarray  # (R, N, 2) m: each ring's step displacement, the Newton unknown
+    delta: np.ndarray  # (R, N, 2) m: the last correction (for backtracking)
+    xe: np.ndarray  # (R, N, 2) m: the force evaluation point
+    xn: np.ndarray  # (R, N, 2) m: the positions a correction moves to
+    force: np.ndarray  # (R, N, 2) N: the contact force between rings at xe
+    res: np.ndarray  # (R, 2N): each ring's residual
+    step: np.ndarray  # (R, 2N): the joint Newton correction
+    reaction: np.ndarray  # (R, N) N: ground reactions of the last residual
+    friction: np.ndarray  # (R, N) N
+    tangential: np.ndarray  # (R, N) N
+    arrival: np.ndarray  # (R,) J: work of the velocity reset on moving grounds
+    transfer: np.ndarray  # (R,) J: energy the contact between rings gave each ring in the step
+    work: np.ndarray  # (R,) J: |work| of the contact force on each ring in the step
+    cols: np.ndarray  # (2N, 1 + 2N): a ring's right-hand side and its coupling's unit columns
+    z: np.ndarray  # (R, 2N, 1 + 2N): A_r^-1 of them, per ring
+    zu: np.ndarray  # (2N, MAX_LOW_RANK + 2N): B^-1 U of a ring's low-rank columns
+    ring_cap: np.ndarray  # (MAX_LOW_RANK + 2N, MAX_LOW_RANK + 2N): a ring's capacitance
+    ring_piv: np.ndarray  # (MAX_LOW_RANK + 2N,) int64
+    ring_coef: np.ndarray  # (MAX_LOW_RANK + 2N,)
+    cap: np.ndarray  # (C, C): the coupling's capacitance I + W^T Z
+    piv: np.ndarray  # (C,) int64
+    coef: np.ndarray  # (C,)
+
+
 class Workspace(NamedTuple):
     pos: np.ndarray  # (N,) zig-zag position of each node
     band: np.ndarray  # (2N, BAND_COLUMNS)
@@ -156,6 +207,7 @@ class Workspace(NamedTuple):
     collision: CollisionWorkspace
     barrier: BarrierWorkspace | None  # None: the model has no self-contact barrier
     ring_pairs: CollisionWorkspace | None  # ``collision`` again where rings collide, else None
+    ring_contact: RingContactWorkspace | None  # None: rings do not collide through the barrier
 
 
 class State(NamedTuple):
@@ -227,6 +279,7 @@ def build_model(scene, effects=EFFECTS):
         collide=len(rings) > 1 and scene.ring_collision,
         reject_self_intersection=scene.self_intersection in ("reject", "barrier"),
         self_barrier=scene.self_intersection == "barrier",
+        ring_barrier=len(rings) > 1 and scene.ring_collision and scene.self_intersection == "barrier",
         effect_parameters=effect_parameters(scene, effects),
     )
     _fill_rest_energy(model, rings)
@@ -275,14 +328,20 @@ def build_drive(n_rings, n_nodes):
     return Drive(ramp=ramp, push=push, pushed=np.zeros((n_rings, n_nodes), dtype=np.bool_))
 
 
-def build_workspace(n_nodes, n_rings=1, effects=EFFECTS, barrier=True, ring_pairs=True, n_grounds=1):
+def build_workspace(
+    n_nodes, n_rings=1, effects=EFFECTS, barrier=True, ring_pairs=True, n_grounds=1, ring_contact=False,
+    contact_pairs_per_node=RING_PAIRS_PER_NODE,
+):  # fmt: skip
     """Scratch arrays for one ring's Newton solve and the scene's collision detection, allocated
     once per simulation (``effects``: the model's, for the size of the energy table). ``barrier``:
     the self-contact barrier's scratch, or None in its place for a model without it; ``ring_pairs``:
     the collision scratch once more as ``Workspace.ring_pairs`` (the ring-ring code's), or None
-    for a model whose rings cannot collide. A step compiled with None in either place holds none of
-    that code (numba prunes ``if ... is None`` on an argument before typing). ``n_grounds``: at
-    least the model's number of grounds, for the rows of the grounds at the step's times."""
+    for a model whose rings cannot collide; ``ring_contact``: the joint step's scratch of rings in
+    contact through the barrier (needs ``barrier``; ``contact_pairs_per_node``: its room for
+    candidate pairs, :func:`ring_contact.pairs_per_node`), else None. A step compiled with None in any of
+    these places holds none of that code (numba prunes ``if ... is None`` on an argument before
+    typing). ``n_grounds``: at least the model's number of grounds, for the rows of the grounds at
+    the step's times."""
     n2 = 2 * n_nodes
     collision = build_collision_workspace(n_rings, n_nodes)
     return Workspace(
@@ -310,6 +369,69 @@ def build_workspace(n_nodes, n_rings=1, effects=EFFECTS, barrier=True, ring_pair
         collision=collision,
         barrier=build_barrier_workspace(n_nodes) if barrier else None,
         ring_pairs=collision if ring_pairs else None,
+        ring_contact=(
+            build_ring_contact_workspace(n_rings, n_nodes, contact_pairs_per_node)
+            if ring_contact and barrier
+            else None
+        ),
+    )
+
+
+MAX_COUPLING_COLUMNS = 1024  # largest joint capacitance (two columns per node coupled across rings)
+
+
+def build_ring_contact_workspace(n_rings, n_nodes, pairs_per_node=RING_PAIRS_PER_NODE):
+    """Scratch of the joint step of ``n_rings`` rings of ``n_nodes`` nodes in contact, with room
+    for ``pairs_per_node`` candidate pairs per node."""
+    n2 = 2 * n_nodes
+    pairs = pairs_per_node * n_rings * n_nodes
+    entries = ENTRIES_PER_PAIR * pairs
+    k = MAX_LOW_RANK + n2
+    c = min(n_rings * n2, MAX_COUPLING_COLUMNS)
+    shape = (n_rings, n_nodes, 2)
+    return RingContactWorkspace(
+        mode=np.zeros(1, dtype=np.int64),
+        pairs=np.zeros((pairs, PAIR_COLUMNS), dtype=np.int64),
+        n_pairs=np.zeros(1, dtype=np.int64),
+        box=np.zeros((n_rings, 4)),
+        margin=np.zeros(n_rings),
+        order=np.arange(n_rings, dtype=np.int64),
+        ring_pairs=np.zeros((max(1, n_rings * (n_rings - 1) // 2), 2), dtype=np.int64),
+        near=np.zeros(n_nodes, dtype=np.int64),
+        span=np.zeros((2, 4)),
+        g=np.zeros(6),
+        hess=np.zeros((6, 6)),
+        scratch=np.zeros((6, 6)),
+        hessians=np.zeros((pairs, 6, 6)),
+        within=np.zeros(pairs, dtype=np.bool_),
+        slot=np.full((n_rings, n_nodes), -1, dtype=np.int64),
+        first=np.zeros(n_rings + 1, dtype=np.int64),
+        column=np.zeros(entries, dtype=np.int64),
+        ring=np.zeros(entries, dtype=np.int64),
+        dof=np.zeros(entries, dtype=np.int64),
+        value=np.zeros(entries),
+        dx=np.zeros(shape),
+        delta=np.zeros(shape),
+        xe=np.zeros(shape),
+        xn=np.zeros(shape),
+        force=np.zeros(shape),
+        res=np.zeros((n_rings, n2)),
+        step=np.zeros((n_rings, n2)),
+        reaction=np.zeros((n_rings, n_nodes)),
+        friction=np.zeros((n_rings, n_nodes)),
+        tangential=np.zeros((n_rings, n_nodes)),
+        arrival=np.zeros(n_rings),
+        transfer=np.zeros(n_rings),
+        work=np.zeros(n_rings),
+        cols=np.zeros((n2, 1 + n2)),
+        z=np.zeros((n_rings, n2, 1 + n2)),
+        zu=np.zeros((n2, k)),
+        ring_cap=np.zeros((k, k)),
+        ring_piv=np.zeros(k, dtype=np.int64),
+        ring_coef=np.zeros(k),
+        cap=np.zeros((c, c)),
+        piv=np.zeros(c, dtype=np.int64),
+        coef=np.zeros(c),
     )
 
 

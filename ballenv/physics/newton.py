@@ -51,6 +51,7 @@ from .wall_limits import limit_fraction, wall_limit_force, wall_limit_jacobian
 MAX_CONTACT_SET_CHANGES = 64
 PLAIN = 0  # Workspace.barrier.mode[0]: the step without the self-contact barrier
 SAFE = 1  # with it, every correction filtered by continuous collision detection
+COUPLED = 1  # Workspace.ring_contact.mode[0]: rings in contact solved jointly (else 0: one by one)
 MIN_NEWTON_FRACTION = 1.0 / 32.0  # backtracking halves a correction at most 5 times
 FAILED = -1
 
@@ -216,6 +217,20 @@ def _cut_at_impact(model, r, xa, bw):
 
 
 @kernel
+def add_ring_contact_force(r, ws, rc):
+    """In the joint step of rings in contact (``rc.mode[0] == COUPLED``), add ring ``r``'s share of
+    the contact force between rings (``rc.force[r]``, N: :mod:`.ring_newton`) to ``ws.force``."""
+    if rc is None:
+        return
+    if rc.mode[0] != COUPLED:
+        return
+    f = ws.force
+    for i in range(f.shape[0]):
+        for d in range(2):
+            f[i, d] += rc.force[r, i, d]
+
+
+@kernel
 def add_limit_force(model, r, ws, bw):
     """In either mode, add the wall limits' force (:mod:`.wall_limits`) at the force evaluation point
     ``ws.xe`` to ``ws.force`` (nothing unless a node folds or an edge collapses that far)."""
@@ -254,11 +269,13 @@ def limit_filter(c_x, xe, x1, step, bw):
 @kernel
 def add_barrier_force(model, r, ws, bw):
     """In safe mode, add the self-contact barrier's force at the force evaluation point ``ws.xe``
-    (on the candidate pairs of the last correction's motion) to ``ws.force``."""
+    (on the candidate pairs of the last correction's motion) to ``ws.force``; in the joint step of
+    rings in contact, their contact force too (:func:`add_ring_contact_force`)."""
     if bw is None:
         return
     if bw.mode[0] == SAFE and bw.n_pairs[0] > 0:
         barrier_force(ws.xe, bw.pairs, bw.n_pairs[0], stiffness(model, r), reach(model, r), ws.force, bw)
+    add_ring_contact_force(r, ws, ws.ring_contact)
 
 
 @kernel

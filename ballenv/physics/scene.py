@@ -327,8 +327,10 @@ class Scene:
             0 a regulated pressure: each ring's gauge pressure stays at its set value whatever its
             area, a line load ``p b`` with the potential ``-b p A``).
         ring_collision: rings push each other apart when a node comes within the contact distance
-            ``h_a + h_b`` of another ring's centreline (``collision.py``); only with two or more
-            rings. False lets rings pass through each other.
+            ``h_a + h_b`` of another ring's centreline; only with two or more rings. With
+            ``self_intersection = "barrier"`` through a barrier potential inside one implicit step
+            of the rings in contact (``ring_contact.py``, ``ring_newton.py``), otherwise through
+            explicit impulses (``collision.py``). False lets rings pass through each other.
         self_intersection: "barrier" (default: "reject", and wall parts of a ring far apart
             along it repel through a barrier potential inside the implicit step, with continuous
             collision detection on the Newton iterates, so a squashed ring rests folded;

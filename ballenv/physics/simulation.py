@@ -80,10 +80,12 @@ from .model import (
     build_barrier_workspace,
     build_drive,
     build_model,
+    build_ring_contact_workspace,
     build_workspace,
     empty_recording,
     empty_state,
 )
+from .ring_contact import contact_energy_by_ring, pairs_per_node
 from .scene import Scene, check_gauge_pressure, check_real, check_vector
 from .stepper import advance, initial_state_values, record
 
@@ -177,7 +179,8 @@ class Trajectory:
         """Energy (J) per record and ring: dict of (T, n_rings) arrays.
 
         Keys: kinetic, stretching, bending, gas (the gas-law potential), gravity, with the self-contact
-        barrier (``Scene.self_intersection = "barrier"``) self_contact, and total. Computed with
+        barrier (``Scene.self_intersection = "barrier"``) self_contact, with rings colliding through
+        it ring_contact (each node-edge pair's barrier energy, half to either ring), and total. Computed with
         the scene's gas amounts and the registry's effects: records after a
         :meth:`Simulation.set_rest_pressure` hold another amount of gas than this counts.
         """
@@ -215,7 +218,23 @@ def energy(scene: Scene, x: ArrayLike, v: ArrayLike) -> dict[str, NDArray[np.flo
         if bw is not None:
             table[k, -1] = self_contact_energy(model, k % n_rings, xs[k], bw)
     out = {name: table[:, j].reshape(lead) for j, name in enumerate(names)}
-    out["total"] = table.sum(axis=1).reshape(lead)
+    total = table.sum(axis=1).reshape(lead)
+    if model.ring_barrier:
+        between = _contact_energy_by_ring(model, xs.reshape(-1, n_rings, xs.shape[1], 2)).reshape(lead)
+        out["ring_contact"] = between
+        total = total + between
+    out["total"] = total
+    return out
+
+
+def _contact_energy_by_ring(model: Model, states: NDArray[np.float64]) -> NDArray[np.float64]:
+    """(T, R): the barrier energy (J) between rings of each state (T, R, N, 2), each pair's half to
+    either ring."""
+    rw = build_ring_contact_workspace(states.shape[1], states.shape[2], pairs_per_node(model))
+    out = np.zeros(states.shape[:2])
+    for k, x in enumerate(states):
+        x = np.ascontiguousarray(x)
+        contact_energy_by_ring(model, x, rw, out[k])
     return out
 
 
@@ -273,6 +292,8 @@ class Simulation:
             effects,
             barrier=self.model.self_barrier,
             ring_pairs=self.model.collide,
+            ring_contact=self.model.ring_barrier,
+            contact_pairs_per_node=pairs_per_node(self.model),
             n_grounds=len(scene.grounds) + len(scene.drums),
         )
         self.state = empty_state(n_rings, n_nodes)

@@ -14,7 +14,7 @@ import math
 
 from .assembly import ring_force
 from .collision import collision_impulses, collision_step_limit, rings_intrude, self_intersects
-from .contact import FREE, frame, surface_velocity
+from .contact import FREE, frame, rest_on_grounds, surface_velocity
 from .drive import drive_landing, drive_step
 from .effects.gas import ring_pressure
 from .energy import boundary_work, free_energy, within_energy_budget
@@ -58,7 +58,8 @@ from .layout import (
 )
 from .local_error import error_exponent, error_norm
 from .model import CONTACT_NONE
-from .newton import newton_ring
+from .newton import COUPLED, PLAIN, newton_ring
+from .ring_newton import contact_transfers, joint_newton, pay_from_relative_motion, rings_met, rings_touch
 
 CONTINUE = -1  # step_outcome(): retry the step
 
@@ -94,7 +95,7 @@ def collision_kicks(model, state, h, ws):
     if not (model.collide or model.reject_self_intersection):
         return False
     collision_impulses(
-        state.x, state.v, h, model.thickness, model.node_mass, model.collide,
+        state.x, state.v, h, model.thickness, model.node_mass, model.collide and not model.ring_barrier,
         model.reject_self_intersection, cw, cw.kicked, cw.kinetic_change, ws.ring_pairs,
     )  # fmt: skip
     created = 0.0
@@ -106,10 +107,9 @@ def collision_kicks(model, state, h, ws):
 
 @kernel(inline="always")
 def step_ring(model, solver, r, state, v0, trial, h, ws):
-    """Ring ``r``'s trial step and its own acceptance tests: returns its Newton corrections, or
-    minus the ``REJECT_`` code (Newton failed, the wall crossed itself, the energy budget). The
-    energy the step's collision impulses and moving grounds gave the ring
-    (:func:`energy.boundary_work`, tallied) is credited to its energy budget and guard."""
+    """Ring ``r``'s trial step and its own acceptance tests (:func:`ring_checks`): returns its Newton
+    corrections, or minus the ``REJECT_`` code (Newton failed, the wall crossed itself, the energy
+    budget)."""
     copy_into(trial.active[r], state.active[r])
     its = newton_ring(
         model, solver, r, state.x[r], v0[r], state.a[r], h, trial.x[r], trial.v[r], trial.a[r], ws,
@@ -117,11 +117,23 @@ def step_ring(model, solver, r, state, v0, trial, h, ws):
     )  # fmt: skip
     if its < 0:
         return -REJECT_NEWTON
+    code = ring_checks(model, r, state, trial, h, ws, 0.0)
+    return its if code == 0 else code
+
+
+@kernel(inline="always")
+def ring_checks(model, r, state, trial, h, ws, transfer):
+    """Ring ``r``'s acceptance tests of its trial state: 0, or minus the ``REJECT_`` code (the wall
+    crossed itself, the energy budget). The energy the step's collision impulses, the contact with
+    other rings (``transfer``, J: :func:`ring_newton.contact_transfers`) and moving grounds
+    (:func:`energy.boundary_work`, tallied) gave the ring is credited to its energy budget and
+    guard."""
     if model.reject_self_intersection and self_intersects(trial.x[r]):
         return -REJECT_SELF_INTERSECTION
     free_energy(model, r, trial.x[r], trial.v[r], ws, trial.energy[r])
     kicks = model.collide or model.reject_self_intersection
     credit = ws.collision.kinetic_change[r] if kicks else 0.0
+    credit += transfer
     work = 0.0
     if model.moving_grounds:
         work = boundary_work(ws.surface_start, ws.surface, trial.active[r], ws.reaction, ws.friction, h)
@@ -131,7 +143,97 @@ def step_ring(model, solver, r, state, v0, trial, h, ws):
     trial.energy[r, ENERGY_BUDGET] = state.energy[r, ENERGY_BUDGET] + credit
     if not within_energy_budget(model, r, state.energy[r], credit, work, trial, ws):
         return -REJECT_ENERGY
-    return its
+    return 0
+
+
+@kernel(inline="always")
+def ring_rates(model, solver, r, state, v0, trial, h, ws, impulse_ratio, error):
+    """Ring ``r``'s contact forces and its step-size limits (see :func:`try_step`): returns
+    ``impulse_ratio`` and ``error`` with the ring's own taken in."""
+    if model.contact_method != CONTACT_NONE:
+        impulse = contact_impulse(model, solver, r, state, v0, trial, h, ws)
+        if impulse > 0.0:
+            impulse_ratio = min(impulse_ratio, model.impulse_bound[r] / impulse)
+    if solver.rtol > 0.0:
+        error = max(error, ring_error(model, solver, r, state, trial, h))
+    return impulse_ratio, error
+
+
+@kernel(inline="always")
+def joint_energy(model, state, trial, ws, rc):
+    """The rings' energies after a joint step and what the contact between them moved from ring to
+    ring (:func:`ring_newton.contact_transfers`); a gain of the rings in contact taken back from
+    their relative motion (:func:`ring_newton.pay_from_relative_motion`, constrained nodes put back
+    at rest on their grounds; tallied as removed). False if the pairs do not fit."""
+    for r in range(state.x.shape[0]):
+        free_energy(model, r, trial.x[r], trial.v[r], ws, trial.energy[r])
+    gain = contact_transfers(model, state.x, trial.x, state.energy, trial.energy, rc)
+    if gain > 0.0 and pay_from_relative_motion(model, trial.v, rc, gain):
+        ws.energy_tally[TALLY_PROJECTED] += 1.0
+        ws.energy_tally[TALLY_REMOVED] += gain
+        for r in range(state.x.shape[0]):
+            if rc.work[r] > 0.0:
+                rest_on_grounds(ws.surface, trial.active[r], trial.x[r], trial.v[r], trial.a[r])
+                free_energy(model, r, trial.x[r], trial.v[r], ws, trial.energy[r])
+        gain = contact_transfers(model, state.x, trial.x, state.energy, trial.energy, rc)
+    return not math.isnan(gain)
+
+
+@kernel
+def step_rings(model, solver, state, v0, trial, h, ws, rc):
+    """The trial step of every ring: returns (Newton corrections, impulse ratio, local error) as
+    :func:`try_step`, a rejection as ``(-code, 0, 0)``. Ring by ring (:func:`step_ring`,
+    :func:`ring_rates`); with ``rc`` (rings that collide through the barrier), all rings jointly
+    (:func:`joint_rings_step`) if a node starts within the contact distance of another ring
+    (:func:`ring_newton.rings_touch`) or the step solved ring by ring met another ring on the way
+    or at its end (:func:`ring_newton.rings_met`). A compiled call: numba prunes the joint step for
+    ``rc`` None before it inlines or types any of it, so the env and every scene without it compile
+    the ring-by-ring loop only."""
+    if rc is not None:
+        if rings_touch(model, state.x, rc):
+            return joint_rings_step(model, solver, state, v0, trial, h, ws, rc)
+    total = 0
+    impulse_ratio = math.inf
+    error = 0.0
+    for r in range(state.x.shape[0]):
+        its = step_ring(model, solver, r, state, v0, trial, h, ws)
+        if its < 0:
+            return its, 0.0, 0.0
+        total += its
+        impulse_ratio, error = ring_rates(model, solver, r, state, v0, trial, h, ws, impulse_ratio, error)
+    if rc is not None:
+        if rings_met(model, state.x, trial.x, rc):
+            return joint_rings_step(model, solver, state, v0, trial, h, ws, rc)
+    return total, impulse_ratio, error
+
+
+@kernel
+def joint_rings_step(model, solver, state, v0, trial, h, ws, rc):
+    """The trial step of all rings solved jointly with the contact between rings
+    (:func:`ring_newton.joint_newton`), then each ring's acceptance tests and step-size limits:
+    returns (Newton corrections, impulse ratio, local error) as :func:`try_step`."""
+    rc.mode[0] = COUPLED
+    ws.energy_tally[TALLY_BOUNDARY_WORK] = 0.0  # (of a step tried ring by ring first)
+    ws.energy_tally[TALLY_PROJECTED] = 0.0
+    ws.energy_tally[TALLY_REMOVED] = 0.0
+    copy_into(trial.active, state.active)
+    its = joint_newton(model, solver, state, v0, trial, h, ws, rc)
+    rc.mode[0] = PLAIN
+    if its < 0:
+        return -REJECT_NEWTON, 0.0, 0.0
+    if not joint_energy(model, state, trial, ws, rc):
+        return -REJECT_NEWTON, 0.0, 0.0
+    impulse_ratio = math.inf
+    error = 0.0
+    for r in range(state.x.shape[0]):
+        copy_into(ws.reaction, rc.reaction[r])
+        copy_into(ws.friction, rc.friction[r])
+        ws.arrival_work[0] = rc.arrival[r]
+        code = ring_checks(model, r, state, trial, h, ws, rc.transfer[r])
+        if code < 0:
+            return code, 0.0, 0.0
+        impulse_ratio, error = ring_rates(model, solver, r, state, v0, trial, h, ws, impulse_ratio, error)
+    return its, impulse_ratio, error
 
 
 @kernel(inline="always")
@@ -216,31 +318,27 @@ def try_step(model, solver, state, trial, t, h, ws):
     ``(1 - alpha_m) / beta`` for generalized-alpha (whose Newmark update reflects the node's normal
     velocity before :func:`contact.rest_on_grounds` removes it).
 
-    With ring collision, the collision impulses are found on the predicted positions ``x0 + h v0``
-    and added to the start velocities (``collision.py``); each ring's energy guard and energy budget
-    are credited with the change of its kinetic energy by them. Their sum over rings is negative
-    (energy lost) except where they push out nodes that start the step inside the contact distance
-    (a Baumgarte-type term): that net gain is tallied in ``ws.energy_tally``. They are not part of
-    the contact impulse (the part that stops an approaching node does not shrink with the step).
+    With ring collision through the barrier (``model.ring_barrier``, ``ws.ring_contact``), a step
+    whose start has a node within the contact distance of another ring, or that, solved ring by
+    ring, ends within it or passes a node through a wall on the way
+    (:func:`ring_newton.rings_touch`, :func:`ring_newton.rings_met`), is solved for all rings at once
+    (:func:`step_rings`); each ring's energy budget is credited with what the contact moved to it
+    (:func:`ring_newton.contact_transfers`, summing to minus the change of the contact energy).
+    Otherwise, with ring collision, the collision impulses are found on the predicted positions
+    ``x0 + h v0`` and added to the start velocities (``collision.py``); each ring's energy guard
+    and energy budget are credited with the change of its kinetic energy by them. Their sum over
+    rings is negative (energy lost) except where they push out nodes that start the step inside the
+    contact distance (a Baumgarte-type term): that net gain is tallied in ``ws.energy_tally``. They
+    are not part of the contact impulse (the part that stops an approaching node does not shrink
+    with the step).
     """
-    total = 0
-    impulse_ratio = math.inf
-    error = 0.0
     ws.energy_tally[:] = 0.0
     ground_surfaces(model.grounds, t, ws.surface_start)
     ground_surfaces(model.grounds, t + h, ws.surface)
     v0 = ws.collision.kicked if collision_kicks(model, state, h, ws) else state.v
-    for r in range(state.x.shape[0]):
-        its = step_ring(model, solver, r, state, v0, trial, h, ws)
-        if its < 0:
-            return its, 0.0, 0.0
-        total += its
-        if model.contact_method != CONTACT_NONE:
-            impulse = contact_impulse(model, solver, r, state, v0, trial, h, ws)
-            if impulse > 0.0:
-                impulse_ratio = min(impulse_ratio, model.impulse_bound[r] / impulse)
-        if solver.rtol > 0.0:
-            error = max(error, ring_error(model, solver, r, state, trial, h))
+    total, impulse_ratio, error = step_rings(model, solver, state, v0, trial, h, ws, ws.ring_contact)
+    if total < 0:
+        return total, 0.0, 0.0
     if model.collide and rings_intrude(trial.x, model.thickness, ws.ring_pairs):
         return -REJECT_INTRUSION, 0.0, 0.0
     return total, impulse_ratio, error

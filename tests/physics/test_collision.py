@@ -174,8 +174,12 @@ def mirrored_pair(n, speed, gap=0.05):
 
 @pytest.mark.parametrize("integrator", ["generalized_alpha", "backward_euler"])
 def test_head_on_collision_conserves_momentum_and_mirror_symmetry(integrator):
+    # the explicit collision impulses ("reject"; with the barrier: test_ring_contact.py)
     rings, x0, v0, mirror = mirrored_pair(32, 3.0)
-    scene = Scene(rings=rings, gravity=0.0, dt=1e-3, adaptive=True, integrator=integrator, newton_tol=1e-12)
+    scene = Scene(
+        rings=rings, gravity=0.0, dt=1e-3, adaptive=True, integrator=integrator, newton_tol=1e-12,
+        self_intersection="reject",
+    )  # fmt: skip
     traj = simulate(scene, 0.03, x0=x0, v0=v0)
     m = scene.rings[0]
     momentum = traj.v.sum(axis=2)  # (T, 2 rings, 2) in units of the node mass
