@@ -6,8 +6,11 @@
     python -m agents.evaluate path/to/model.zip --algo sac --env-kwargs '{"action_mode": "paddle"}'
 
 Episode ``k`` is reset with seed ``seed + k`` (default 10,000 on: training uses small seeds), so
-the same arguments give the same numbers. Metrics (the reward is the env's training signal; these
-are the task's measures):
+the same arguments give the same numbers. Without ``--env-kwargs``, a run folder is scored on the
+env it trained on, ``random`` and ``heuristic`` on the task of their mode (the ``env_kwargs`` of
+``agents/hyperparams/ppo.yml``, :func:`agents.train.task_env_kwargs`).
+
+Metrics (the reward is the env's training signal; these are the task's measures):
 
 * **apex error**: per episode, the mean of ``|h - h_target| / h_target`` over its flight apexes,
   where each apex missed because the episode ended early (the ball came to rest, left the arena or

@@ -7,7 +7,8 @@ Both search with Optuna's TPE sampler (seeded: the same command gives the same t
 seeds; the held-out seeds of ``agents.evaluate`` (10,000 on) stay unseen.
 
 * ``heuristic``: the controller's parameters (:data:`HEURISTIC_SPACE`); objective the mean apex
-  error over ``--episodes`` episodes seeded 0, 1, ... The best is written to
+  error over ``--episodes`` episodes seeded 0, 1, ... of the task the agents train on (the
+  ``env_kwargs`` of ``hyperparams/ppo.yml``). The best is written to
   ``agents/hyperparams/heuristic.yml`` under the env id, where ``agents.baselines.HeuristicPolicy``
   reads it (``--dry-run``: print it only).
 * ``ppo``: the hyperparameters of :func:`sample_ppo` (the ranges of RL Baselines3 Zoo's PPO
