@@ -95,14 +95,15 @@ def load_hyperparams(algo: str, mode: str) -> dict[str, Any]:
     return dict(table[ENV_IDS[mode]])
 
 
-def task_env_kwargs(algo: str, mode: str, extra: dict[str, Any] | None = None) -> dict[str, Any]:
-    """The env keywords of the task ``algo`` trains on in action mode ``mode``: the YAML entry's
-    ``env_kwargs``, updated with ``extra`` (a command line's ``--env-kwargs``), and the mode. What
-    the training envs get, and what every policy compared with the trained one is scored on."""
-    env_kwargs = dict(load_hyperparams(algo, mode).get("env_kwargs") or {})
-    env_kwargs.update(extra or {})
-    env_kwargs["action_mode"] = mode
-    return env_kwargs
+def task_env_kwargs(
+    algo: str, mode: str, extra: dict[str, Any] | None = None, entry: Mapping[str, Any] | None = None
+) -> dict[str, Any]:
+    """The env keywords of the task ``algo`` trains on in action mode ``mode``: the ``env_kwargs``
+    of ``entry`` (default: the YAML entry), updated with ``extra`` (a command line's
+    ``--env-kwargs``), and the mode. What the training envs get, and what every policy compared with
+    the trained one is scored on."""
+    entry = load_hyperparams(algo, mode) if entry is None else entry
+    return {**(entry.get("env_kwargs") or {}), **(extra or {}), "action_mode": mode}
 
 
 def run_folder(log_dir: str | os.PathLike[str], algo: str, mode: str, seed: int) -> pathlib.Path:
@@ -301,7 +302,7 @@ def train(args: argparse.Namespace, on_evaluation: OnEvaluation | None = None) -
 
     hp = load_hyperparams(args.algo, args.action_mode)
     hp.update(args.hyperparams or {})
-    env_kwargs = {**(hp.get("env_kwargs") or {}), **(args.env_kwargs or {}), "action_mode": args.action_mode}
+    env_kwargs = task_env_kwargs(args.algo, args.action_mode, args.env_kwargs, entry=hp)
     n_envs = args.n_envs or int(hp.get("n_envs", 1))
     total = args.total_timesteps or int(hp["n_timesteps"])
     normalize = bool(hp.get("normalize", True))

@@ -37,7 +37,8 @@ from ballenv.physics import Ring, Scene, simulate  # noqa: E402
 from ballenv.physics.collision import find_contacts  # noqa: E402
 from ballenv.physics.model import build_collision_workspace, build_model, build_ring_contact_workspace  # noqa: E402
 from ballenv.physics.ring_contact import find_ring_pairs  # noqa: E402
-from tests.physics.test_collision import box, mirrored_pair, settling_scene  # noqa: E402
+from tests.physics import test_collision as collision_tests  # noqa: E402
+from tests.physics.test_collision import mirrored_pair  # noqa: E402
 from tests.physics.test_ring_contact import five_balls  # noqa: E402
 
 RESULTS = ROOT / "benchmarks" / "results"
@@ -55,19 +56,7 @@ def stacked(mode):
 
 
 def eight_balls(mode):
-    rng = np.random.default_rng(0)
-    rings = [
-        Ring(
-            radius=0.1,
-            n_nodes=32,
-            pressure=30e3,
-            position=(-0.375 + 0.25 * (k % 4) + 0.005 * rng.standard_normal(), 0.3 + 0.26 * (k // 4)),
-            velocity=(rng.uniform(-1.0, 1.0), 0.0),
-        )  # fmt: skip
-        for k in range(8)
-    ]
-    scene = replace(settling_scene(rings, box(0.55, 1.2, 0.3)), self_intersection=mode)
-    return scene, 3.0, {"output_dt": 0.01}
+    return replace(collision_tests.eight_balls(), self_intersection=mode), 3.0, {"output_dt": 0.01}
 
 
 SCENES = {"head-on, 2 balls": head_on, "5 balls stacked": stacked, "8 balls in a box": eight_balls}

@@ -246,7 +246,8 @@ def test_ball_dropped_on_a_resting_ball_settles_stacked():
     assert centres[1, 1] > centres[0, 1] + 0.18  # stacked
 
 
-def test_eight_balls_in_a_box_settle():
+def eight_balls():
+    """Eight N = 32 balls in two rows of four, jittered and thrown sideways (seeded), in a box."""
     rng = np.random.default_rng(0)
     rings = [
         Ring(
@@ -258,7 +259,11 @@ def test_eight_balls_in_a_box_settle():
         )  # fmt: skip
         for k in range(8)
     ]
-    traj = simulate(settling_scene(rings, box(0.55, 1.2, 0.3)), 3.0, output_dt=0.01)
+    return settling_scene(rings, box(0.55, 1.2, 0.3))
+
+
+def test_eight_balls_in_a_box_settle():
+    traj = simulate(eight_balls(), 3.0, output_dt=0.01)
     assert np.all(np.isfinite(traj.x))
     assert no_intrusion(traj.x, np.full(8, 2e-3))
     kinetic = traj.energy()["kinetic"].sum(axis=1)
