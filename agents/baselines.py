@@ -4,6 +4,8 @@
 * :class:`RandomPolicy`: uniform actions in [-1, 1] from its own seeded generator;
 * :class:`HeuristicPolicy`: the scripted controller of the env's action mode
   (:class:`ballenv.controllers.PressurePump` or :class:`ballenv.controllers.PaddleDribble`);
+* :class:`agents.lookahead.LookaheadPump` ("lookahead"): the pressure mode's privileged reference,
+  the pump's timing with each bounce's amplitude found by trying amplitudes on copies of the simulator;
 * :class:`ModelPolicy`: a saved Stable-Baselines3 model (deterministic actions), with the
   observation normalisation (``VecNormalize`` statistics) it was trained with.
 """
@@ -24,6 +26,7 @@ from ballenv.envs.inflated_ball import ball_env
 from ballenv.physics.ring import total_mass
 
 ALGORITHMS = ("ppo", "sac")
+NAMED_POLICIES = ("random", "heuristic", "lookahead")  # make_policy's policies by name
 HEURISTIC_PARAMS = pathlib.Path(__file__).parent / "hyperparams" / "heuristic.yml"
 
 
@@ -176,18 +179,23 @@ def make_policy(
     env: gym.Env[Any, Any],
     algo: str | None = None,
 ) -> Policy:
-    """``"random"``, ``"heuristic"``, a path to a saved model / run folder, or a callable ``env ->
-    policy`` -> a policy."""
+    """``"random"``, ``"heuristic"``, ``"lookahead"`` (pressure mode's privileged reference,
+    :mod:`agents.lookahead`), a path to a saved model / run folder, or a callable ``env -> policy``
+    -> a policy."""
     if callable(spec):
         return spec(env)
     if spec == "random":
         return RandomPolicy(env)
     if spec == "heuristic":
         return HeuristicPolicy(env)
+    if spec == "lookahead":
+        from .lookahead import LookaheadPump
+
+        return LookaheadPump(env)
     path = pathlib.Path(spec)
     if not path.exists():
         raise ValueError(
-            f"agents.evaluate: policy = {str(spec)!r} is invalid: must be 'random', 'heuristic', a saved "
-            "model (.zip) or a train.py run folder (no such file or folder)"
+            f"agents.evaluate: policy = {str(spec)!r} is invalid: must be one of {NAMED_POLICIES}, a "
+            "saved model (.zip) or a train.py run folder (no such file or folder)"
         )
     return ModelPolicy(env, path, algo)

@@ -38,7 +38,7 @@ import numpy as np
 from ballenv.envs.config import BallEnvConfig
 from ballenv.envs.inflated_ball import ball_env
 
-from .baselines import Policy, make_policy
+from .baselines import NAMED_POLICIES, Policy, make_policy
 
 ENV_ID = "ballenv:InflatedBall-v3"
 SUCCESS_TOLERANCE = 0.05  # relative apex error counted as a success
@@ -98,7 +98,7 @@ def evaluate(
     algo: str | None = None,
     progress: bool = False,
 ) -> Score:
-    """Score ``policy`` ("random", "heuristic", a saved model / run folder, or a callable ``env ->
+    """Score ``policy`` (one of ``NAMED_POLICIES``, a saved model / run folder, or a callable ``env ->
     policy``) over ``episodes`` episodes of ``gym.make(ENV_ID, **env_kwargs)`` seeded ``seed, seed +
     1, ...``."""
     env = gym.make(ENV_ID, **(env_kwargs or {}))
@@ -121,7 +121,7 @@ def evaluate(
     err = np.array(per_episode)
     half = 1.96 * err.std(ddof=1) / math.sqrt(len(err)) if len(err) > 1 else math.nan
     return Score(
-        policy=agent.name if policy in ("random", "heuristic") or callable(policy) else str(policy),
+        policy=agent.name if policy in NAMED_POLICIES or callable(policy) else str(policy),
         episodes=episodes,
         apex_error=float(err.mean()),
         apex_error_ci95=float(half),
@@ -163,7 +163,7 @@ def parse_env_kwargs(text: str) -> dict[str, Any]:
 def build_parser() -> argparse.ArgumentParser:
     """The command line of ``python -m agents.evaluate`` / ``ballenv-evaluate``."""
     parser = argparse.ArgumentParser(prog="ballenv-evaluate", description=__doc__.split("\n")[0])
-    parser.add_argument("policy", help='"random", "heuristic", a model .zip or a run folder of train.py')
+    parser.add_argument("policy", help=f"one of {NAMED_POLICIES}, a model .zip or a run folder of train.py")
     parser.add_argument("--action-mode", choices=("pressure", "paddle"), help="shortcut for env_kwargs")
     parser.add_argument("--env-kwargs", type=parse_env_kwargs, default=None, help="JSON object")
     parser.add_argument("--episodes", type=int, default=20, help="held-out episodes (default 20)")
@@ -177,7 +177,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     parser = build_parser()
     args = parser.parse_args(argv)
     env_kwargs = dict(args.env_kwargs or {})
-    if args.env_kwargs is None and args.policy not in ("random", "heuristic"):
+    if args.env_kwargs is None and args.policy not in NAMED_POLICIES:
         env_kwargs = _run_env_kwargs(args.policy)
     elif args.env_kwargs is None:  # a baseline: on the task the agents of its mode train on
         from .train import task_env_kwargs

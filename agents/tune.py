@@ -39,10 +39,12 @@ from .train import task_env_kwargs
 # name -> (low, high, log scale) of each controller parameter
 HEURISTIC_SPACE = {
     "pressure": {
-        "landing_height": (0.15, 0.6, False),  # m: pump from this height on the way down
-        "gain": (0.5, 16.0, True),  # amplitude per relative apex error
-        "bias": (0.0, 1.0, False),  # amplitude on target
-        "floor": (-1.0, 0.5, False),  # smallest amplitude
+        # where the next apex answers the amplitude (benchmarks/pump_response.py: it rises from -45 %
+        # to +30 % of the target as u goes from about 0 to 0.2, saturated outside)
+        "landing_height": (0.13, 0.25, False),  # m: pump from this height on the way down
+        "gain": (0.05, 2.0, True),  # amplitude per relative apex error
+        "bias": (0.0, 0.25, False),  # amplitude on target
+        "floor": (-0.3, 0.1, False),  # smallest amplitude
     },
     "paddle": {"retention": (0.5, 0.95, False)},  # fraction of a bounce's energy kept
 }

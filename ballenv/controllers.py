@@ -58,8 +58,14 @@ class PressurePump(_Controller):
         if not contact and vy > 0.0:
             apex = y + vy * vy / (2.0 * self.g)
             self.amplitude = min(1.0, max(self.floor, self.bias + self.gain * (target - apex) / target))
+        return self.timed(obs, self.amplitude)
+
+    def timed(self, obs: NDArray[np.float32], amplitude: float) -> NDArray[np.float32]:
+        """The pump's timing of amplitude ``amplitude``: the action ``+amplitude`` while the ball is
+        on the ground or falls below ``landing_height``, ``-amplitude`` otherwise."""
+        y, vy, contact, _ = self._read(obs)
         landing = contact or (vy < 0.0 and y < self.landing_height)
-        return np.array([self.amplitude if landing else -self.amplitude], dtype=np.float32)
+        return np.array([amplitude if landing else -amplitude], dtype=np.float32)
 
 
 class PaddleDribble(_Controller):

@@ -81,7 +81,8 @@ def test_a_hyperparameter_typo_is_one_readable_line_and_leaves_no_run_folder(tmp
 
 
 def test_a_mistyped_policy_names_the_choices(capsys):
-    with pytest.raises(ValueError, match="policy = 'heuristc' is invalid: must be 'random', 'heuristic'"):
+    choices = "must be one of \\('random', 'heuristic', 'lookahead'\\)"
+    with pytest.raises(ValueError, match="policy = 'heuristc' is invalid: " + choices):
         evaluate("heuristc", {"max_episode_steps": 5}, episodes=1)
     with pytest.raises(SystemExit):
         main(["heuristc", "--episodes", "1"])

@@ -617,6 +617,34 @@ class BallBatch:
             self._step_batch = compiled_entry(step_batch, args)
         self._step_batch(*args)
 
+    def env_arrays(self) -> dict[str, NDArray[Any]]:
+        """Every array with one row per env (leading axis E), by name: an env's whole state (its
+        model rows, where a reset sets the gas, included). The workspace is scratch, not state."""
+        arrays = {f"model.{name}": getattr(self.model, name) for name in PER_RING_FIELDS}
+        for group in ("drive", "state", "trial", "records", "task"):
+            record = getattr(self, group)
+            arrays.update(
+                (f"{group}.{name}", value)
+                for name, value in zip(record._fields, record, strict=True)
+                if isinstance(value, np.ndarray)
+            )
+        arrays.update(clocks=self.clocks, counters=self.counters, raw=self.raw, obs=self.obs)
+        return arrays
+
+    def copy_env(self, source: "BallBatch", e: int, rows: ArrayLike) -> None:
+        """Set envs ``rows`` of this batch to env ``e`` of ``source`` (a batch of the same scene and
+        task settings; it may be this one): from here they step exactly as env ``e`` would, to the
+        bit. What lookahead planning needs: try actions on copies of a state."""
+        if source.n_nodes != self.n_nodes or source.task.mode != self.task.mode:
+            raise ValueError(
+                f"BallBatch.copy_env: source has {source.n_nodes} nodes in mode {source.task.mode}, "
+                f"this batch {self.n_nodes} in mode {self.task.mode}: must be equal"
+            )
+        rows = np.asarray(rows, dtype=np.int64)
+        mine = self.env_arrays()
+        for name, array in source.env_arrays().items():
+            mine[name][rows] = array[e]
+
     def close(self) -> None:
         """Stop the step threads (if any)."""
         if self._pool is not None:

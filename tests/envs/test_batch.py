@@ -10,7 +10,14 @@ import pytest
 
 import ballenv  # noqa: F401  (registers the env)
 from ballenv.controllers import PaddleDribble, PressurePump
-from ballenv.envs.batch import ENVS_PER_LINE, REWARD_AT_MARGIN, env_model, guided_chunks, height_reward
+from ballenv.envs.batch import (
+    ENVS_PER_LINE,
+    REWARD_AT_MARGIN,
+    BallBatch,
+    env_model,
+    guided_chunks,
+    height_reward,
+)
 from ballenv.envs.inflated_ball import InflatedBallEnv
 from ballenv.physics.actuation import set_gas
 from ballenv.physics.layout import CLOCK_T, PUSH_DELIVERED, PUSH_T_END, PUSH_T_START, RAMP_T_END
@@ -255,3 +262,33 @@ def test_the_paddle_strikes_only_a_ball_in_flight(action):
         assert strikes == 0 and falling_in_flight > 20
     else:
         assert strikes >= 3  # one per flight
+
+
+@pytest.mark.parametrize("mode", MODES)
+def test_a_copied_env_steps_exactly_as_its_source(mode):
+    """Copies of an env mid-episode (in flight or squashed on the ground, the gas ramping, a strike
+    under way) step to the bit as the env itself does, whatever row they land in."""
+    env = InflatedBallEnv(action_mode=mode)
+    env.reset(seed=5)
+    rng = np.random.default_rng(5)
+    for _ in range(37):
+        env.step(rng.uniform(-1.0, 1.0, size=1).astype(np.float32))
+    source = env._batch
+    low, high = env.config.observation_bounds()
+    copies = BallBatch(env.config.scene(), 3, env.config.task_settings(), low, high)
+    copies.copy_env(source, 0, [0, 2])
+    for _ in range(60):
+        action = rng.uniform(-1.0, 1.0)
+        source.step(np.array([action]))
+        copies.step(np.array([action, 0.0, action]), np.array([True, False, True]))
+        for row in (0, 2):
+            np.testing.assert_array_equal(copies.obs[row], source.obs[0])
+            np.testing.assert_array_equal(copies.task.reward[row], source.task.reward[0])
+            np.testing.assert_array_equal(copies.state.x[row], source.state.x[0])
+    assert copies.task.steps[1] == 0  # the row not copied, not stepped, is untouched
+
+
+def test_copy_env_between_batches_of_different_balls_is_refused():
+    small, large = InflatedBallEnv(fidelity="fast"), InflatedBallEnv(fidelity="balanced")
+    with pytest.raises(ValueError, match="32 nodes .* 64 .* must be equal"):
+        large._batch.copy_env(small._batch, 0, [0])

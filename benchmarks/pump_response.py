@@ -1,0 +1,164 @@
+"""How a bounce's apex answers the pump's amplitude in the pressure mode, and how much of the right
+amplitude the ball's observed state tells.
+
+    python benchmarks/pump_response.py [--episodes 30]   # writes benchmarks/results/pump_response.md
+
+The env is InflatedBall-v3's pressure mode (fast preset), played by ``agents.lookahead.LookaheadPump``:
+at the start and after each flight apex it tries 41 amplitudes ``u`` in [-0.3, 0.3] with the pump's
+timing (``+u`` on the ground and below the tuned landing height, ``-u`` above) on copies of the
+simulator and keeps the best. Each such decision gives the signed relative error ``(h - h_t) / h_t``
+of the next apex after a landing as a function of ``u``. Reported:
+
+* one decision's response curve;
+* over all decisions: ``u*``, the amplitude where the response crosses zero (linear between the
+  two candidates around it), the slope ``dh/du / h_t`` there, and the scatter of ``u*`` left by
+  least-squares fits on what the scripted pump and a ball-as-body agent observe (last apex error,
+  target, horizontal velocity, pressure); ``slope x residual`` is the apex error such a fit leaves;
+* the held-out scores (episodes from seed 10,000, ``agents.evaluate``) of the lookahead and of the
+  tuned scripted pump.
+"""
+
+import argparse
+import os
+import pathlib
+import sys
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import numpy as np  # noqa: E402
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+import ballenv  # noqa: E402, F401  (registers the env)
+from agents.evaluate import evaluate  # noqa: E402
+from agents.lookahead import LookaheadPump  # noqa: E402
+from agents.study import summarise, table  # noqa: E402
+
+RESULT = ROOT / "benchmarks" / "results" / "pump_response.md"
+KWARGS = {"action_mode": "pressure"}  # the env's defaults: the task the agents train on
+BODY = ("last apex error", "target", "horizontal velocity", "pressure")  # what the pump sees
+SHAPE = (
+    "spin", "rotation phase (cos, sin)", "shape modes 2, 3", "breathing (radius, its rate)",
+    "landing time within the control step (cos, sin)",
+)  # what only the nodes, or the clock, tell  # fmt: skip
+
+
+class RecordedLookahead(LookaheadPump):
+    """The lookahead, keeping at each decision the observed features and the response curve."""
+
+    def __init__(self, env):
+        super().__init__(env)
+        self.structure = env.unwrapped.observation_structure
+        self.rows, self.curves = [], []
+
+    def act(self, obs):
+        plans = self.amplitude is None or self.env_batch.task.apex_count[0] > 0
+        action = super().act(obs)
+        if plans and np.isfinite(self.candidate_errors).all():
+            self.rows.append(features(obs, self.structure))
+            self.curves.append(self.candidate_errors.copy())
+        return action
+
+
+def features(obs, structure, dt=0.01, g=9.81):
+    """The decision's features: BODY (4 numbers), then SHAPE (1 + 2 + 2 + 2 + 2): the ring's spin
+    (rad/s), its rotation phase ``N theta`` within one node spacing, the amplitudes of its radius'
+    modes 2 and 3 relative to its mean, its mean radius (m) and mean radial velocity (m/s) (nodes
+    relative to the centre of mass), and where in its control step the ball's centre will fall to
+    one mean radius above the ground, ``t = (v_y + sqrt(v_y^2 + 2 g (y - r))) / g`` in units of
+    ``dt``, as an angle."""
+    target = obs[structure["target_height"]][0]
+    body = [
+        (target - obs[structure["last_apex"]][0]) / target, target,
+        obs[structure["centre_of_mass_velocity"]][0], obs[structure["pressure"]][0],
+    ]  # fmt: skip
+    xy = obs[structure["node_position"]].reshape(-1, 2).astype(float)
+    v = obs[structure["node_velocity"]].reshape(-1, 2).astype(float)
+    r2 = (xy**2).sum(axis=1)
+    spin = np.mean((xy[:, 0] * v[:, 1] - xy[:, 1] * v[:, 0]) / r2)
+    phase = np.angle(np.mean(np.exp(1j * len(xy) * np.arctan2(xy[:, 1], xy[:, 0]))))
+    r = np.sqrt(r2)
+    radius = np.abs(np.fft.rfft(r))
+    y, vy = obs[structure["centre_of_mass_position"]][1], obs[structure["centre_of_mass_velocity"]][1]
+    fall = (vy + np.sqrt(max(vy * vy + 2.0 * g * (y - r.mean()), 0.0))) / g
+    grid = 2.0 * np.pi * (fall / dt % 1.0)
+    shape = [spin, np.cos(phase), np.sin(phase), radius[2] / radius[0], radius[3] / radius[0]]
+    return body + shape + [r.mean(), np.mean((xy * v).sum(axis=1) / r), np.cos(grid), np.sin(grid)]
+
+
+def decisions(episodes):
+    """The lookahead's held-out score, and (observed features, signed response over the amplitudes)
+    of each of its decisions, and the amplitudes."""
+    made = []
+    score = evaluate(lambda env: made.append(RecordedLookahead(env)) or made[-1], KWARGS, episodes)
+    policy = made[-1]
+    return score, np.array(policy.rows), np.array(policy.curves), policy.amplitudes
+
+
+def zero_crossings(curves, amplitudes):
+    """Per decision: the amplitude where the response first crosses zero upwards and the slope
+    there (over three candidates each side); NaN where it does not cross."""
+    u_star, slope = np.full(len(curves), np.nan), np.full(len(curves), np.nan)
+    for n, c in enumerate(curves):
+        up = np.flatnonzero((c[:-1] < 0) & (c[1:] >= 0))
+        if up.size:
+            i = up[0]
+            u_star[n] = amplitudes[i] - c[i] * (amplitudes[i + 1] - amplitudes[i]) / (c[i + 1] - c[i])
+            lo, hi = max(i - 2, 0), min(i + 3, len(c) - 1)
+            slope[n] = (c[hi] - c[lo]) / (amplitudes[hi] - amplitudes[lo])
+    return u_star, slope
+
+
+def residual_sd(u_star, features):
+    """Standard deviation of ``u_star`` left by a least-squares fit on ``features`` (and a constant)."""
+    design = (
+        np.column_stack([np.ones(len(u_star)), *features.T]) if features.size else np.ones((len(u_star), 1))
+    )
+    coef, *_ = np.linalg.lstsq(design, u_star, rcond=None)
+    return float(np.std(u_star - design @ coef))
+
+
+def report(rows, curves, amplitudes, scores):
+    u_star, slope = zero_crossings(curves, amplitudes)
+    ok = np.isfinite(u_star)
+    u, x, s = u_star[ok], rows[ok], float(np.median(slope[ok]))
+    shown = np.arange(0, len(amplitudes), 4)
+    lines = [
+        "# The pump's amplitude and the next apex (InflatedBall-v3, pressure mode)",
+        "",
+        "One decision (seed 10,000, the first): signed error of the next apex after a landing,",
+        "",
+        "| u | " + " | ".join(f"{amplitudes[k]:+.2f}" for k in shown) + " |",
+        "|---|" + "---:|" * len(shown),
+        "| (h - h_t) / h_t | " + " | ".join(f"{curves[0][k]:+.3f}" for k in shown) + " |",
+        "",
+        f"Over {len(curves)} decisions of {scores['episodes']} episodes ({ok.sum()} cross zero): "
+        f"u* mean {u.mean():.3f}, sd {u.std():.3f}; slope (median) {s:.2f} per unit u.",
+        "",
+        "| fit of u* on | residual sd of u* | apex error it leaves (slope x sd) |",
+        "|---|---:|---:|",
+    ]
+    fits = [(k, ", ".join(BODY[:k]) or "a constant") for k in range(len(BODY) + 1)]
+    fits.append((x.shape[1], "all of these and the shape: " + ", ".join(SHAPE)))
+    for k, label in fits:
+        sd = residual_sd(u, x[:, :k])
+        lines.append(f"| {label} | {sd:.4f} | {s * sd:.3f} |")
+    lines += ["", f"Held-out episodes from seed 10,000 (``agents.evaluate``): {scores['episodes']} each.", ""]
+    lines.append(table([summarise(score.policy, [score]) for score in scores["rows"]]))
+    return "\n".join(lines) + "\n"
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--episodes", type=int, default=30)
+    args = parser.parse_args()
+    lookahead, rows, curves, amplitudes = decisions(args.episodes)
+    scores = {"episodes": args.episodes, "rows": [lookahead, evaluate("heuristic", KWARGS, args.episodes)]}
+    text = report(rows, curves, amplitudes, scores)
+    RESULT.write_text(text)
+    print(text)
+
+
+if __name__ == "__main__":
+    main()
