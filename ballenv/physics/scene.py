@@ -294,13 +294,15 @@ class Scene:
             pushed; see ``stepper.try_step``); larger steps are rejected and shrunk by the ratio,
             smaller ones grow by at most x1.25. Not used when ``rtol`` > 0 (which sets its own bound).
         rtol: error control of the adaptive step, dimensionless in [0, 1]; 0 (default): off, the step
-            follows ``impulse_tol`` alone. Above 0 (with ``adaptive``), every step keeps two measures
-            within it: the local error estimate of the integrator (``local_error.py``), its RMS over a
-            ring's nodes at most ``atol + rtol R`` (m, ``R`` the ring's radius), and the contact impulse
-            (as for ``impulse_tol``) at most ``rtol M sqrt(g R)`` (N s, ``M`` the ring's mass: the
-            momentum of the ring falling its own radius), so the same ``rtol`` asks the same relative
-            accuracy of a 3 g ring and a 500 g ball. What it achieves on six balls:
-            ``benchmarks/accuracy.py``.
+            follows ``impulse_tol`` alone. Above 0 (with ``adaptive``), every step keeps the local
+            error estimate of the integrator (``local_error.py``), its RMS over a ring's nodes, at most
+            ``atol + rtol R`` (m, ``R`` the ring's radius); a step with a node on a ground at either
+            end also keeps its contact errors within the same ``rtol`` (``contact_error.py``): the
+            distance arriving nodes still had to go, the step doubling of the ring's rigid motion
+            (velocity against ``rtol sqrt(g R)``, m/s) and the contact impulse at most
+            ``2 sqrt(rtol) M sqrt(g R)`` (N s, ``M`` the ring's mass: the momentum of the ring falling
+            its own radius), so the same ``rtol`` asks the same relative accuracy of a 3 g ring and a
+            500 g ball. What it achieves on six balls: ``benchmarks/accuracy.py``.
         atol: absolute local error tolerance on positions (m) in [0, 1], added to ``rtol R``.
         friction_regularization: slip speed eps (m/s) in (0, 1] below which Coulomb friction is
             smoothed, ``mu N v / sqrt(v^2 + eps^2)``. A sticking node creeps at about eps times its
