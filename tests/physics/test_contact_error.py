@@ -1,5 +1,6 @@
 """The contact error estimate (step doubling) against the true local error of a step with node
-arrivals, and the error that ``Scene.rtol`` achieves on the ball family."""
+arrivals, and the error that ``Scene.rtol`` with ``contact_error = "doubling"`` achieves on the
+ball family."""
 
 import dataclasses
 import json
@@ -11,8 +12,10 @@ import numpy as np
 import pytest
 
 from ballenv.physics import Ground, Ring, Scene, Simulation
-from ballenv.physics.contact_error import arrival_norm, doubling_norm, rigid_motion
+from ballenv.physics.contact_error import LIFTOFF_IMPULSE, arrival_norm, doubling_norm, rigid_motion
 from ballenv.physics.integrator import build_solver
+from ballenv.physics.model import impulse_bounds
+from ballenv.physics.ring import total_mass
 
 sys.path.insert(0, str(Path(__file__).parents[2] / "benchmarks"))
 import ball_family  # noqa: E402
@@ -92,18 +95,23 @@ def test_arrival_norm_is_the_mean_distance_still_to_go():
 
 
 def test_doubling_only_with_error_control_and_contact():
-    """The half steps' scratch (and their compiled code) exists only for ``rtol`` > 0 with a ground."""
+    """The half steps' scratch (and their compiled code) exists only for ``rtol`` > 0 and
+    ``contact_error = "doubling"`` with a ground."""
     scene = _landing_scene(gap=1e-3)
-    assert Simulation(dataclasses.replace(scene, adaptive=True, rtol=1e-3)).ws.doubling is not None
-    assert Simulation(dataclasses.replace(scene, adaptive=True)).ws.doubling is None
-    assert Simulation(dataclasses.replace(scene, adaptive=True, rtol=1e-3, grounds=())).ws.doubling is None
+    doubling = dataclasses.replace(scene, adaptive=True, rtol=1e-3, contact_error="doubling")
+    assert Simulation(doubling).ws.doubling is not None
+    assert Simulation(dataclasses.replace(doubling, rtol=0.0)).ws.doubling is None
+    assert Simulation(dataclasses.replace(doubling, grounds=())).ws.doubling is None
+    assert Simulation(dataclasses.replace(doubling, contact_error="impulse")).ws.doubling is None
 
 
 def _family_errors(name, tolerances):
     reference = json.loads(REFERENCES.read_text())[name]["apex"]
     errors = []
     for rtol in tolerances:
-        scene = ball_family.ball_scene(name, adaptive=True, dt=1e-2, rtol=rtol, rho_infinity=0.9)
+        scene = ball_family.ball_scene(
+            name, adaptive=True, dt=1e-2, rtol=rtol, rho_infinity=0.9, contact_error="doubling"
+        )
         apex, _ = ball_family.first_apex(name, scene)
         errors.append(abs(apex - reference) / reference)
     return errors
@@ -111,10 +119,27 @@ def _family_errors(name, tolerances):
 
 @pytest.mark.parametrize("name", ["env", "basketball"])
 def test_error_falls_with_the_tolerance_on_the_family(name):
-    """Two balls of ``benchmarks/ball_family.py`` (a light ring on a slope, a heavy ball with friction)
-    against their cached references: the first-apex error falls at every tightening of ``rtol`` from
-    3e-2 to 1e-3 and stays below 4 ``rtol`` (the family: 0.06-3.5 ``rtol``, ``accuracy.py``)."""
+    """Under ``contact_error = "doubling"``, two balls of ``benchmarks/ball_family.py`` (a light ring
+    on a slope, a heavy ball with friction) against their cached references: the first-apex error
+    falls at every tightening of ``rtol`` from 3e-2 to 1e-3 and stays below 4 ``rtol`` (the family:
+    0.06-3.5 ``rtol``, ``accuracy.py``)."""
     tolerances = (3e-2, 1e-2, 3e-3, 1e-3)
     errors = _family_errors(name, tolerances)
     assert all(b < a for a, b in zip(errors, errors[1:], strict=False)), errors
     assert all(e <= 4.0 * t for e, t in zip(errors, tolerances, strict=True)), errors
+
+
+def test_doubling_bound_on_the_contact_impulse():
+    """With ``contact_error = "doubling"`` the contact impulse per step is bounded by
+    ``2 sqrt(rtol) M sqrt(g R)`` (N s), the default keeps ``rtol M sqrt(g R)``."""
+    scene = Scene(rings=[RING], adaptive=True, rtol=1e-2)
+    mass = total_mass(RING)
+    default = impulse_bounds(scene)[0]
+    doubling = impulse_bounds(dataclasses.replace(scene, contact_error="doubling"))[0]
+    assert default == pytest.approx(1e-2 * mass * math.sqrt(9.81 * RING.radius))
+    assert doubling == pytest.approx(LIFTOFF_IMPULSE * 0.1 * mass * math.sqrt(9.81 * RING.radius))
+
+
+def test_contact_error_is_validated():
+    with pytest.raises(ValueError, match="contact_error"):
+        Scene(contact_error="halving")
