@@ -306,8 +306,9 @@ class Scene:
             radius). "doubling": the contact errors of ``contact_error.py`` (the distance arriving
             nodes still had to go, the step doubling of the ring's rigid motion, the contact impulse
             at most ``2 sqrt(rtol) M sqrt(g R)``): an error closer to proportional to ``rtol``
-            (0.06-3.5 ``rtol`` on the six balls against 0.02-0.91, monotone on five of them), at
-            1.3-3x the wall time of "impulse" for the same achieved error on five of the six.
+            (0.06-3.5 ``rtol`` on the six balls against 0.02-0.91, monotone on five of them against
+            three), at 1.2-3.4x the wall time of "impulse" for the same achieved error on five of
+            the six (the basketball-like ball 1.6x less).
         atol: absolute local error tolerance on positions (m) in [0, 1], added to ``rtol R``.
         friction_regularization: slip speed eps (m/s) in (0, 1] below which Coulomb friction is
             smoothed, ``mu N v / sqrt(v^2 + eps^2)``. A sticking node creeps at about eps times its
