@@ -10,7 +10,11 @@ Error: the first-apex height of the centre of mass, relative to the ball's conve
 error estimated against twice that). The references are cached in
 ``benchmarks/results/accuracy_references.json`` (``--references`` recomputes them: about 6
 minutes). Cost: wall time (median of three runs, numba warm), accepted and rejected steps. All
-runs: generalized-alpha, ``rho_infinity`` = 0.9, adaptive, largest step 10 ms, N = 64.
+runs: generalized-alpha, ``rho_infinity`` = 0.9, adaptive, largest step 10 ms, N = 64. Each
+tolerance with both controls of the step in contact (``Scene.contact_error``): "impulse" (the
+contact impulse at most ``rtol M sqrt(g R)``) and "doubling" (the contact errors of
+``ballenv/physics/contact_error.py``); the table says per ball and control whether the error fell at
+every tightening of ``rtol``, and the range of achieved over requested.
 """
 
 import os
@@ -32,6 +36,7 @@ from ballenv.physics.presets import FIDELITY_PRESETS, with_fidelity  # noqa: E40
 RESULTS = pathlib.Path(__file__).parent / "results"
 REFERENCES = RESULTS / "accuracy_references.json"
 TOLERANCES = (3e-2, 1e-2, 3e-3, 1e-3)
+CONTROLS = ("impulse", "doubling")  # Scene.contact_error
 NUMERICS = dict(adaptive=True, dt=1e-2, rho_infinity=0.9)
 
 
@@ -67,13 +72,15 @@ def measure(name, scene, reference, repeats=3):
 
 
 def sweep(refs, tolerances, progress=print):
-    """ball -> {"rtol=x": run, preset name: run}."""
+    """ball -> {"<control> rtol=x": run, preset name: run}."""
     runs = {}
     for name in BALLS:
         ref = refs[name]["apex"]
         runs[name] = {}
-        for rtol in tolerances:
-            runs[name][f"rtol={rtol:g}"] = measure(name, ball_scene(name, rtol=rtol, **NUMERICS), ref)
+        for control in CONTROLS:
+            for rtol in tolerances:
+                scene = ball_scene(name, rtol=rtol, contact_error=control, **NUMERICS)
+                runs[name][f"{control} rtol={rtol:g}"] = measure(name, scene, ref)
         for preset in FIDELITY_PRESETS:  # node count as the preset says; reference at N = 64
             runs[name][preset] = measure(name, with_fidelity(ball_scene(name), preset), ref)
         progress(f"{name}: " + ", ".join(f"{k} {v['error']:.1e}" for k, v in runs[name].items()))
@@ -87,21 +94,36 @@ def report(refs, runs, tolerances):
         "",
         "`python benchmarks/accuracy.py` (balls: `benchmarks/ball_family.py`; generalized-alpha, "
         "rho_inf 0.9, adaptive, largest step 10 ms, N = 64). Error: first-apex height relative to the "
-        "ball's converged fixed-step reference; `err/rtol`: achieved over requested.",
+        "ball's converged reference; `err/rtol`: achieved over requested; monotone: the error fell at "
+        "every tightening of rtol. Control: `Scene.contact_error`, impulse (the contact impulse at most "
+        "rtol M sqrt(g R), the default) or doubling (the contact errors of "
+        "`ballenv/physics/contact_error.py`).",
         "",
-        "| ball | p R^3/EI | reference apex (m) | ref. uncertainty | "
+        "| ball | control | p R^3/EI | reference apex (m) | ref. uncertainty | "
         + " | ".join(f"rtol {t:g}: err (err/rtol), wall ms, steps" for t in tolerances)
-        + " |",
-        "|---|---:|---:|---:|" + "---:|" * len(tolerances),
+        + " | monotone |",
+        "|---|---|---:|---:|---:|" + "---:|" * len(tolerances) + "---|",
     ]
+    ratios = {control: [] for control in CONTROLS}
     for name in BALLS:
-        cells = []
-        for t in tolerances:
-            r = runs[name][f"rtol={t:g}"]
-            cells.append(f"{r['error']:.1e} ({r['error'] / t:.2f}), {r['wall'] * 1e3:.0f}, {r['steps']}")
+        for control in CONTROLS:
+            rs = [runs[name][f"{control} rtol={t:g}"] for t in tolerances]
+            cells = []
+            for t, r in zip(tolerances, rs, strict=True):
+                ratios[control].append(r["error"] / t)
+                cells.append(f"{r['error']:.1e} ({r['error'] / t:.2f}), {r['wall'] * 1e3:.0f}, {r['steps']}")
+            falls = all(b["error"] < a["error"] for a, b in zip(rs, rs[1:], strict=False))
+            lines.append(
+                f"| {name} | {control} | {gas_to_bending(name):,.1f} | {refs[name]['apex']:.5f} | "
+                f"{refs[name]['uncertainty']:.0e} | " + " | ".join(cells) + f" | {'yes' if falls else 'no'} |"
+            )
+    lines.append("")
+    for control, qs in ratios.items():
+        inside = sum(0.3 <= q <= 3.0 for q in qs)
+        walls = sum(runs[n][f"{control} rtol={t:g}"]["wall"] for n in BALLS for t in tolerances)
         lines.append(
-            f"| {name} | {gas_to_bending(name):,.1f} | {refs[name]['apex']:.5f} | "
-            f"{refs[name]['uncertainty']:.0e} | " + " | ".join(cells) + " |"
+            f"- {control}: err/rtol {min(qs):.2f}-{max(qs):.2f}, within 0.3-3 in {inside} of {len(qs)} "
+            f"runs; wall time of the {len(qs)} runs {walls:.2f} s."
         )
     lines += ["", "The fidelity presets (their own node counts; error against the N = 64 reference):", ""]
     lines += ["| ball | " + " | ".join(f"{p}: err, wall ms" for p in FIDELITY_PRESETS) + " |"]
@@ -120,15 +142,19 @@ def plot(runs, tolerances, path):
     import matplotlib.pyplot as plt
 
     fig, (ax_wp, ax_ratio) = plt.subplots(1, 2, figsize=(11, 4.2))
-    for name in BALLS:
-        rs = [runs[name][f"rtol={t:g}"] for t in tolerances]
-        ax_wp.loglog([r["wall"] * 1e3 for r in rs], [r["error"] for r in rs], "o-", label=name)
-        ratios = [r["error"] / t for r, t in zip(rs, tolerances, strict=True)]
-        ax_ratio.loglog(tolerances, ratios, "o-", label=name)
+    for k, name in enumerate(BALLS):
+        for control, style in zip(CONTROLS, ("o--", "s-"), strict=True):
+            rs = [runs[name][f"{control} rtol={t:g}"] for t in tolerances]
+            label = f"{name}, {control}"
+            color = f"C{k}"
+            walls, errors = [r["wall"] * 1e3 for r in rs], [r["error"] for r in rs]
+            ax_wp.loglog(walls, errors, style, color=color, label=label)
+            ratios = [r["error"] / t for r, t in zip(rs, tolerances, strict=True)]
+            ax_ratio.loglog(tolerances, ratios, style, color=color, label=label)
     ax_wp.set(xlabel="wall time (ms)", ylabel="first-apex error (relative)", title="work-precision")
     ax_ratio.axhspan(0.3, 3.0, color="0.9", label="0.3-3x")
     ax_ratio.set(xlabel="requested rtol", ylabel="achieved error / rtol", title="tolerance proportionality")
-    ax_ratio.legend(fontsize=8)
+    ax_ratio.legend(fontsize=6, ncol=2)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
 

@@ -23,6 +23,7 @@ from .assembly import (
 )
 from .barrier import PAIRS_PER_NODE
 from .collision import CONTACT_COLUMNS, CONTACTS_PER_NODE
+from .contact_error import LIFTOFF_IMPULSE
 from .effects import EFFECTS
 from .effects.damping import DAMPING_CENTRE_OF_MASS, DAMPING_NONE, DAMPING_RIGID
 from .ground_motion import ground_array, grounds_move, surface_array
@@ -208,6 +209,7 @@ class Workspace(NamedTuple):
     barrier: BarrierWorkspace | None  # None: the model has no self-contact barrier
     ring_pairs: CollisionWorkspace | None  # ``collision`` again where rings collide, else None
     ring_contact: RingContactWorkspace | None  # None: rings do not collide through the barrier
+    doubling: "DoublingWorkspace | None"  # None: no step doubling in contact (``contact_error.py``)
 
 
 class State(NamedTuple):
@@ -217,6 +219,15 @@ class State(NamedTuple):
     active: np.ndarray  # (R, N) int64: constraining ground of each node, or -1
     contact_force: np.ndarray  # (R, N, 2) N
     energy: np.ndarray  # (R, ENERGY.size) J: each ring's energy, its free part and its budget (layout.ENERGY)
+
+
+class DoublingWorkspace(NamedTuple):
+    """The two half steps of a step in contact, whose difference from the whole step is its contact
+    error (``contact_error.py``)."""
+
+    mid: State  # the state after the first half step
+    fine: State  # the state after the second half step
+    tally: np.ndarray  # (TALLY.size,) the first half step's energy tallies (layout.TALLY)
 
 
 class Recording(NamedTuple):
@@ -301,11 +312,16 @@ def impulse_bounds(scene):
     """(R,) the adaptive step's bound on a ring's contact impulse per step (N s): ``Scene.impulse_tol``,
     or with error control (``Scene.rtol`` > 0) ``rtol M sqrt(g R)``, relative to the momentum of the
     ring (mass ``M``, kg; radius ``R``, m) falling its own radius (``g`` = 9.81 m/s^2 without
-    gravity)."""
+    gravity); with ``Scene.contact_error = "doubling"`` ``LIFTOFF_IMPULSE sqrt(rtol) M sqrt(g R)``:
+    there the contact errors of :mod:`.contact_error` control the step in contact, and this bound
+    only what they cannot see (a node released a step early)."""
     if scene.rtol == 0.0:
         return np.full(len(scene.rings), float(scene.impulse_tol))
     g = float(np.hypot(*scene.gravity_vector)) or 9.81
-    return np.array([scene.rtol * ring_geometry.total_mass(r) * math.sqrt(g * r.radius) for r in scene.rings])
+    factor = scene.rtol
+    if scene.contact_error == "doubling":
+        factor = LIFTOFF_IMPULSE * math.sqrt(scene.rtol)
+    return np.array([factor * ring_geometry.total_mass(r) * math.sqrt(g * r.radius) for r in scene.rings])
 
 
 def effect_parameters(scene, effects=EFFECTS):
@@ -330,7 +346,7 @@ def build_drive(n_rings, n_nodes):
 
 def build_workspace(
     n_nodes, n_rings=1, effects=EFFECTS, barrier=True, ring_pairs=True, n_grounds=1, ring_contact=False,
-    contact_pairs_per_node=RING_PAIRS_PER_NODE,
+    contact_pairs_per_node=RING_PAIRS_PER_NODE, doubling=False,
 ):  # fmt: skip
     """Scratch arrays for one ring's Newton solve and the scene's collision detection, allocated
     once per simulation (``effects``: the model's, for the size of the energy table). ``barrier``:
@@ -341,7 +357,8 @@ def build_workspace(
     candidate pairs, :func:`ring_contact.pairs_per_node`), else None. A step compiled with None in any of
     these places holds none of that code (numba prunes ``if ... is None`` on an argument before
     typing). ``n_grounds``: at least the model's number of grounds, for the rows of the grounds at
-    the step's times."""
+    the step's times. ``doubling``: the half steps' states of the step doubling in contact, else None
+    (:func:`build_doubling_workspace`)."""
     n2 = 2 * n_nodes
     collision = build_collision_workspace(n_rings, n_nodes)
     return Workspace(
@@ -374,6 +391,14 @@ def build_workspace(
             if ring_contact and barrier
             else None
         ),
+        doubling=build_doubling_workspace(n_rings, n_nodes) if doubling else None,
+    )
+
+
+def build_doubling_workspace(n_rings, n_nodes):
+    """A :class:`DoublingWorkspace` for ``n_rings`` rings of ``n_nodes`` nodes."""
+    return DoublingWorkspace(
+        mid=empty_state(n_rings, n_nodes), fine=empty_state(n_rings, n_nodes), tally=np.zeros(TALLY.size)
     )
 
 

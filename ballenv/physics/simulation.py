@@ -73,6 +73,7 @@ from .layout import (
     STATUS_STEP_TOO_SMALL,
 )
 from .model import (
+    CONTACT_NONE,
     Drive,
     Model,
     Recording,
@@ -295,6 +296,11 @@ class Simulation:
             ring_contact=self.model.ring_barrier,
             contact_pairs_per_node=pairs_per_node(self.model),
             n_grounds=len(scene.grounds) + len(scene.drums),
+            doubling=(
+                self.solver.rtol > 0.0
+                and scene.contact_error == "doubling"
+                and self.model.contact_method != CONTACT_NONE
+            ),
         )
         self.state = empty_state(n_rings, n_nodes)
         self.trial = empty_state(n_rings, n_nodes)

@@ -15,6 +15,7 @@ import math
 from .assembly import ring_force
 from .collision import collision_impulses, collision_step_limit, rings_intrude, self_intersects
 from .contact import FREE, frame, rest_on_grounds, surface_velocity
+from .contact_error import arrival_norm, doubling_norm, in_contact
 from .drive import drive_landing, drive_step
 from .effects.gas import ring_pressure
 from .energy import boundary_work, free_energy, within_energy_budget
@@ -345,6 +346,50 @@ def try_step(model, solver, state, trial, t, h, ws):
 
 
 @kernel
+def doubled_step(model, solver, state, trial, t, h, its, impulse_ratio, error, ws, dw):
+    """With error control in contact (``dw``, ``ws.doubling``: not None), the contact errors of a step
+    of size ``h`` (s) from ``state`` at ``t`` (s) whose whole step ``trial`` (:func:`try_step`: ``its``
+    Newton corrections, ``impulse_ratio``, local error ``error``) has a ring in contact
+    (:mod:`.contact_error`): the arrival error, then, if that is within tolerance, the step again as
+    two halves, whose end ``trial`` becomes (with the energy tallies of both) and whose difference
+    from the whole step is the doubling error. Returns (Newton corrections, impulse ratio, local
+    error) as :func:`try_step`, the error the largest of ``error``, the halves' and the contact errors,
+    each as a norm with the integrator's exponent (:func:`local_error.error_exponent`). Otherwise
+    returns its arguments (numba prunes the rest for ``dw`` None: the step of a scene without error
+    control holds none of this code)."""
+    if dw is None:
+        return its, impulse_ratio, error
+    if its < 0 or not in_contact(state, trial):
+        return its, impulse_ratio, error
+    exponent = 1.0 / error_exponent(solver)  # a norm with factor norm^(-1) as one with the integrator's
+    for r in range(state.x.shape[0]):
+        error = max(error, arrival_norm(model, solver, r, state, trial, ws.surface_start) ** exponent)
+    if error > 1.0:
+        return its, impulse_ratio, error
+    total = its
+    start = state
+    end = dw.mid
+    for half in range(2):
+        its_half, _, error_half = try_step(model, solver, start, end, t + 0.5 * half * h, 0.5 * h, ws)
+        if its_half < 0:
+            return its_half, 0.0, 0.0
+        total += its_half
+        error = max(error, error_half)
+        if half == 0:
+            copy_into(dw.tally, ws.energy_tally)
+            start = dw.mid
+            end = dw.fine
+    for k in range(ws.energy_tally.shape[0]):
+        ws.energy_tally[k] += dw.tally[k]
+    ground_surfaces(model.grounds, t, ws.surface_start)
+    exponent = 0.5 / error_exponent(solver)  # a norm with factor norm^(-1/2) as one with the integrator's
+    for r in range(state.x.shape[0]):
+        error = max(error, doubling_norm(model, solver, r, trial, dw.fine) ** exponent)
+    copy_state(trial, dw.fine)
+    return total, impulse_ratio, error
+
+
+@kernel
 def record(model, k, t, state, rec):
     """Write ``state`` at time ``t`` (s) as record ``k`` of ``rec``."""
     rec.t[k] = t
@@ -466,7 +511,8 @@ def advance(model, solver, ws, state, trial, clock, counters, t_pause, t_end, ou
     ``ratio`` is the smallest of ``bound / (f h)`` over rings with ground contact (the contact
     impulse, :func:`try_step`, against ``model.impulse_bound``) and, with error control
     (``solver.rtol`` > 0), ``err^(-1/(p+1))`` of the scaled local error ``err``
-    (:mod:`.local_error`). A step with ``ratio`` < 1 is retried with ``h * max(0.2, 0.9 ratio)``;
+    (:mod:`.local_error`), and for a step in contact its contact errors (:func:`doubled_step`). A
+    step with ``ratio`` < 1 is retried with ``h * max(0.2, 0.9 ratio)``;
     accepted steps grow by ``min(growth, 1 + (ratio - 1) / 2)`` (cautious), up to ``dt``.
     """
     capacity = rec.t.shape[0]
@@ -485,6 +531,9 @@ def advance(model, solver, ws, state, trial, clock, counters, t_pause, t_end, ou
             drive_step(model, solver, state, clock[CLOCK_T], stop, ws, drive)
         h = stop - clock[CLOCK_T]
         its, impulse_ratio, error = try_step(model, solver, state, trial, clock[CLOCK_T], h, ws)
+        its, impulse_ratio, error = doubled_step(
+            model, solver, state, trial, clock[CLOCK_T], h, its, impulse_ratio, error, ws, ws.doubling
+        )
         error_factor = math.inf if error == 0.0 else error ** -error_exponent(solver)
         ratio = min(impulse_ratio, error_factor)
         status = step_outcome(solver, clock, counters, h, its, ratio, error_factor < impulse_ratio)
