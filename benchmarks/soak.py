@@ -110,6 +110,7 @@ def soak_scenes(count, seed):
     removed = {"backward_euler": [], "generalized_alpha": []}
     worst = []
     crashes = []
+    stops = []
     for index in tqdm(range(count), desc="scenes", unit="scene"):
         scene, t_end = random_scene(rng)
         tally["cases"] += 1
@@ -134,6 +135,8 @@ def soak_scenes(count, seed):
         tally["push-out above start"] += above_start and not grew
         tally["projected runs"] += result.traj.stats.energy_projected > 0
         tally["projected steps"] += result.traj.stats.energy_projected
+        tally["rescued runs"] += result.traj.stats.newton_rescues > 0
+        tally["rescued steps"] += result.traj.stats.newton_rescues
         if result.finite:
             growth[scene.integrator].append(result.energy_growth)
             removed[scene.integrator].append(result.energy_removed)
@@ -144,8 +147,9 @@ def soak_scenes(count, seed):
         else:
             key = next((v for k, v in FAILURE_KEYS.items() if k in result.error), None)
             ends[key if key and result.documented else f"undocumented: {result.error[:80]}"] += 1
+            stops.append((index, key or result.error[:80], float(result.traj.t[-1]), t_end, scene))
     worst.sort(key=lambda w: -w[0])
-    return tally, rejected, ends, growth, removed, worst, crashes
+    return tally, rejected, ends, growth, removed, worst, crashes, stops
 
 
 POLICIES = ("uniform", "plus", "minus", "alternating")
@@ -197,7 +201,7 @@ def main():
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args()
     start = time.perf_counter()
-    tally, rejected, ends, growth, removed, worst, crashes = soak_scenes(args.scenes, args.seed)
+    tally, rejected, ends, growth, removed, worst, crashes, stops = soak_scenes(args.scenes, args.seed)
     scene_time = time.perf_counter() - start
     episodes = soak_episodes(args.episodes, args.seed + 1)
     wall = time.perf_counter() - start
@@ -231,6 +235,9 @@ def main():
         "",
         "Rejected steps by reason: " + ", ".join(f"{k} {rejected[k]:,}" for k in REASONS) + ".",
         "",
+        f"Newton's rescue (`Scene.newton_rescue_max_iter`) took {tally['rescued steps']:,} steps in "
+        f"{tally['rescued runs']} runs (each a run that stopped at `dt_min` without it).",
+        "",
         f"Deepest node below a ground in any accepted state: {tally['deepest']:.2g} m (tolerance "
         f"{GROUND_TOLERANCE:g} m).",
         "",
@@ -250,6 +257,15 @@ def main():
         ],
         "",
     ]
+    if stops:
+        lines += ["Stops (scene index: how, at t of t_end; ring N, h/R, friction):", ""]
+        for index, how, t, t_end, scene in stops:
+            r = scene.rings[0]
+            lines.append(
+                f"* {index}: {how}, at {t:.4g} of {t_end:.4g} s; {len(scene.rings)} ring(s) of N "
+                f"{r.n_nodes}, h/R {r.thickness / r.radius:.3g}, friction {scene.grounds[0].friction:.2f}"
+            )
+        lines.append("")
     for index, scene, t_end, where in crashes:
         lines += [f"Crash in scene {index} (t_end {t_end:.4g} s): `{scene}`", "", "```", *where, "```", ""]
     if worst:

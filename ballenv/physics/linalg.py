@@ -224,6 +224,22 @@ def _solve_columns(lu, pos, src, first, count, work, dst):
                     dst[2 * node + d, start + c] = work[p + d, c]
 
 
+@kernel(inline="always")
+def _capacitance(v, z, n, rank, cap):
+    """``cap = I + V^T Z`` (``rank`` x ``rank``) of the Woodbury identity for ``v``, ``z`` (``n`` rows,
+    >= ``rank`` columns): row by row of both (their storage order; each entry still sums over the
+    rows in order) and skipping the zeros of ``v`` (the barrier's columns have a few nonzeros)."""
+    for a in range(rank):
+        for c in range(rank):
+            cap[a, c] = 1.0 if a == c else 0.0
+    for k in range(n):
+        for a in range(rank):
+            va = v[k, a]
+            if va != 0.0:
+                for c in range(rank):
+                    cap[a, c] += va * z[k, c]
+
+
 @kernel
 def solve_band_wide_low_rank(band, pos, u, v, rank, rhs, work, z, cap, coef):
     """Solve (B + U V^T) x = rhs in place for ``rank`` low-rank columns of any number (``u``, ``v``
@@ -239,18 +255,15 @@ def solve_band_wide_low_rank(band, pos, u, v, rank, rhs, work, z, cap, coef):
         for c in range(rank):
             z[k, c] = u[k, c]
     _solve_columns(band, pos, z, 0, rank + 1, work, z)
+    _capacitance(v, z, n, rank, cap)
     for a in range(rank):
-        s = 0.0
-        for c in range(rank):
-            cap[a, c] = 1.0 if a == c else 0.0
-        for k in range(n):
+        coef[a] = 0.0
+    for k in range(n):  # (row by row: v is read along its rows; each sum still runs over k in order)
+        zk = z[k, rank]
+        for a in range(rank):
             va = v[k, a]
-            if va == 0.0:
-                continue
-            s += va * z[k, rank]
-            for c in range(rank):
-                cap[a, c] += va * z[k, c]
-        coef[a] = s
+            if va != 0.0:
+                coef[a] += va * zk
     if rank > 0 and not _small_solve(cap, coef, rank):
         return False
     for k in range(n):
@@ -323,22 +336,18 @@ def solve_band_low_rank_columns(band, pos, u, v, rank, cols, n_cols, work, z, ca
     _solve_columns(band, pos, cols, 0, n_cols, work, cols)
     if rank == 0:
         return True
-    for a in range(rank):
-        for c in range(rank):
-            cap[a, c] = 1.0 if a == c else 0.0
-        for k in range(n):
-            va = v[k, a]
-            if va != 0.0:
-                for c in range(rank):
-                    cap[a, c] += va * z[k, c]
+    _capacitance(v, z, n, rank, cap)
     if not lu_factor(cap, rank, piv):
         return False
     for c in range(n_cols):
         for a in range(rank):
-            s = 0.0
-            for k in range(n):
-                s += v[k, a] * cols[k, c]
-            coef[a] = s
+            coef[a] = 0.0
+        for k in range(n):  # (row by row, as in _capacitance; a zero term adds nothing)
+            ck = cols[k, c]
+            for a in range(rank):
+                va = v[k, a]
+                if va != 0.0:
+                    coef[a] += va * ck
         lu_solve(cap, rank, piv, coef)
         for k in range(n):
             s = cols[k, c]

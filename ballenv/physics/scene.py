@@ -330,6 +330,14 @@ class Scene:
         newton_tol: Newton tolerance on the residual relative to the forces it balances
             (dimensionless), in [1e-14, 1e-2].
         newton_max_iter: Newton iterations before the step is rejected, in [1, 200].
+        newton_rescue_max_iter: Newton iterations of a rescued step, in [0, 200]: when rejections
+            for Newton failures have halved a step below ``dt_min``, the step is tried once more
+            from the last accepted state and ``dt`` with this many iterations allowed, with the
+            friction regularisation and, failing that, with it 10 and 100 times larger
+            (``simulation.RESCUE_REGULARIZATION``: full Newton steps can cycle on Coulomb friction
+            at any step size); the run stops only if all fail, and goes on with the scene's
+            settings after a rescued step. At most ``newton_max_iter`` (e.g. 0): no rescue. A run
+            that never stops at ``dt_min`` is the same whatever its value.
         atmospheric_pressure: p_atm (Pa) in [0, 1e7]; 0 gives the paper's ``p A = const``.
         gas_exponent: k in ``(p + p_atm) A^k = const`` in [0, 3] (1 isothermal, 1.4 adiabatic air;
             0 a regulated pressure: each ring's gauge pressure stays at its set value whatever its
@@ -368,6 +376,7 @@ class Scene:
     dt_min: float = 1e-9
     newton_tol: float = 1e-9
     newton_max_iter: int = 25
+    newton_rescue_max_iter: int = 200
     atmospheric_pressure: float = 101325.0
     gas_exponent: float = 1.0
     ring_collision: bool = True
@@ -411,6 +420,11 @@ class Scene:
         )
         s(self, "newton_tol", check_real(o, "newton_tol", self.newton_tol, 1e-14, 1e-2))
         s(self, "newton_max_iter", check_int(o, "newton_max_iter", self.newton_max_iter, 1, 200))
+        s(
+            self,
+            "newton_rescue_max_iter",
+            check_int(o, "newton_rescue_max_iter", self.newton_rescue_max_iter, 0, 200),
+        )
         s(
             self,
             "atmospheric_pressure",

@@ -65,6 +65,7 @@ from .layout import (
     GROUND_RADIUS,
     N_CLOCK,
     N_COUNTERS,
+    REJECT_NEWTON,
     REJECTION_REASONS,
     REJECTIONS,
     STATUS_BUFFER_FULL,
@@ -95,6 +96,8 @@ if TYPE_CHECKING:
 
 EVENT_ROWS_PER_RING = 64  # starting room of the event buffer (it grows)
 RECORDS = 1024  # starting room of the recording when every step is recorded (it grows)
+# factors on Scene.friction_regularization that Newton's rescue of a step tries in turn (_rescued)
+RESCUE_REGULARIZATION = (1.0, 10.0, 100.0)
 SHORTEST_EDGE = 1e-6  # shortest edge of a starting ring (fraction of its rest edge length)
 
 
@@ -123,7 +126,8 @@ class SimulationStats:
     distance, summed over the steps where their net effect was a gain (a source of energy besides
     actuation); ``boundary_work`` (J): the work moving grounds did on the rings,
     ``sum_steps h sum_i f_i . w`` (``energy.boundary_work``; 0 with fixed grounds), which their
-    energy budgets are credited with."""
+    energy budgets are credited with; ``newton_rescues``: steps taken by Newton's rescue after a
+    stop at ``dt_min`` (``Scene.newton_rescue_max_iter``)."""
 
     steps: int
     rejected_steps: int
@@ -136,6 +140,7 @@ class SimulationStats:
     energy_removed: float = 0.0
     collision_gain: float = 0.0
     boundary_work: float = 0.0
+    newton_rescues: int = 0
 
 
 @dataclass
@@ -322,6 +327,8 @@ class Simulation:
         record(self.model, 0, 0.0, self.state, self.rec)
         self.counters[COUNT_RECORDS] = 1
         self.failure: str | None = None
+        self.rescues = 0  # steps Newton's rescue took (_rescued)
+        self._rescue_failed = False  # the last stop came after a rescue that failed
         self.drive: Drive | None = None  # actuation spread over time (drive.py), made on first use
         # gauge pressure at rest (Pa) of each ring's gas amount, until a ramp takes it over (Drive.ramp)
         self._rest_pressures = np.array([r.pressure or 0.0 for r in scene.rings])
@@ -347,6 +354,8 @@ class Simulation:
             status = self._advance_to(target, t)
             if bar is not None:
                 bar.update(self.clock[CLOCK_T] - bar.n)
+            if status != STATUS_DONE and self._rescued(status, t):
+                continue
             if status != STATUS_DONE:
                 self.failure = self._failure_message(status)
                 break
@@ -366,6 +375,37 @@ class Simulation:
                 return status
             self.rec = _grown(self.rec, self.counters)
 
+    def _rescued(self, status: int, t_end: float) -> bool:
+        """Newton's rescue of a run that stopped because rejections for Newton failures halved the
+        step below ``dt_min`` (``status``): from the last accepted state (the stop left it
+        untouched), one step is tried again from ``dt`` with ``Scene.newton_rescue_max_iter``
+        iterations allowed, with the scene's friction regularisation ``eps`` and, if that fails
+        too, with ``eps`` times each of ``RESCUE_REGULARIZATION[1:]`` in turn (Coulomb friction's
+        regularised sign ``v / sqrt(v^2 + eps^2)`` is a near step function of the slip that full
+        Newton steps can cycle on at any step size; a larger ``eps`` smooths it). The first that
+        converges and passes the acceptance tests is taken; then the run goes on with the scene's
+        settings. True if a rescue step was taken (``stopping at t_end`` bounds its step)."""
+        cap = self.scene.newton_rescue_max_iter
+        if status != STATUS_STEP_TOO_SMALL or self.counters[COUNT_REJECTION] != REJECT_NEWTON:
+            return False
+        if cap <= self.solver.newton_max_iter:
+            return False
+        model, solver = self.model, self.solver
+        factors = RESCUE_REGULARIZATION if self.model.friction_regularization > 0.0 else (1.0,)
+        self._rescue_failed = True
+        try:  # (same types in both: the same compiled step)
+            self.solver = solver._replace(newton_max_iter=cap)
+            for factor in factors:
+                self.model = model._replace(friction_regularization=factor * model.friction_regularization)
+                self.clock[CLOCK_H] = solver.dt
+                if self._advance_to(float(np.nextafter(self.t, np.inf)), t_end) == STATUS_DONE:
+                    self.rescues += 1
+                    self._rescue_failed = False
+                    return True
+        finally:
+            self.model, self.solver = model, solver
+        return False
+
     def _failure_message(self, status: int) -> str:
         scene, t = self.scene, self.t
         if status == STATUS_IMPULSE_AT_DT_MIN and scene.rtol > 0.0:
@@ -382,6 +422,11 @@ class Simulation:
             )
         assert status == STATUS_STEP_TOO_SMALL, status
         reason = REJECTION_REASONS.get(int(self.counters[COUNT_REJECTION]), "the step was rejected")
+        if self._rescue_failed:
+            reason += (
+                f" (Newton's rescue failed too: {scene.newton_rescue_max_iter} iterations, friction "
+                f"regularisation up to {RESCUE_REGULARIZATION[-1]:g} times Scene.friction_regularization)"
+            )
         return (
             f"step size fell below Scene.dt_min = {scene.dt_min:g} s at t = {t:.6g} s "
             f"(tried {self.clock[CLOCK_H] * 2:.3g} s): {reason}. The scene may be too stiff or too "
@@ -490,6 +535,7 @@ class Simulation:
             energy_removed=float(clock[CLOCK_ENERGY_REMOVED]),
             collision_gain=float(clock[CLOCK_COLLISION_GAIN]),
             boundary_work=float(clock[CLOCK_BOUNDARY_WORK]),
+            newton_rescues=self.rescues,
         )
 
     def trajectory(self) -> Trajectory:

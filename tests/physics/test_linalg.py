@@ -8,9 +8,12 @@ from ballenv.physics.linalg import (
     BAND_COLUMNS,
     BAND_HALF_WIDTH,
     MAX_LOW_RANK,
+    SOLVE_COLUMNS,
     band_add_block,
     band_to_dense,
     solve_band_low_rank,
+    solve_band_low_rank_columns,
+    solve_band_wide_low_rank,
     zigzag_positions,
 )
 from ballenv.physics.model import build_model, build_workspace
@@ -95,3 +98,43 @@ def test_zero_pivot_is_reported_not_divided_by():
         band, pos, u, u, 0, x, np.zeros((2 * n, 1 + MAX_LOW_RANK)),
         np.zeros((MAX_LOW_RANK, MAX_LOW_RANK)), np.zeros(MAX_LOW_RANK),
     )  # fmt: skip
+
+
+def _wide_factors(n_nodes, dense_rank, sparse_rank, seed):
+    """Low-rank factors ``u, w`` (2N, rank) of the self-contact barrier's kind: ``dense_rank``
+    dense columns (the effects'), then ``sparse_rank`` columns of a unit ``u`` and a ``w`` with six
+    nonzeros (a coupled node's row)."""
+    rng = np.random.default_rng(seed)
+    rank = dense_rank + sparse_rank
+    u = np.zeros((2 * n_nodes, rank))
+    w = np.zeros((2 * n_nodes, rank))
+    u[:, :dense_rank] = rng.standard_normal((2 * n_nodes, dense_rank))
+    w[:, :dense_rank] = rng.standard_normal((2 * n_nodes, dense_rank)) / n_nodes
+    for c in range(dense_rank, rank):
+        u[rng.integers(2 * n_nodes), c] = 1.0
+        w[rng.choice(2 * n_nodes, 6, replace=False), c] = rng.standard_normal(6)
+    return u, w
+
+
+@pytest.mark.parametrize("n_nodes", [8, 64, 257])
+@pytest.mark.parametrize("ranks", [(0, 0), (3, 0), (0, 12), (4, 30)])
+def test_wide_and_many_column_solves_equal_dense_solves(n_nodes, ranks):
+    pos, band, _, _ = _random_cyclic_system(n_nodes, 0, seed=n_nodes)
+    u, w = _wide_factors(n_nodes, *ranks, seed=n_nodes + sum(ranks))
+    rank, n2 = u.shape[1], 2 * n_nodes
+    dense = band_to_dense(band, pos) + u @ w.T
+    cols = np.random.default_rng(3).standard_normal((n2, 7))
+    expected = np.linalg.solve(dense, cols)
+    room = max(rank, 1)
+    x = cols[:, 0].copy()
+    assert solve_band_wide_low_rank(
+        band.copy(), pos, u, w, rank, x, np.zeros((n2, SOLVE_COLUMNS)), np.zeros((n2, rank + 1)),
+        np.zeros((room, room)), np.zeros(room),
+    )  # fmt: skip
+    assert np.max(np.abs(x - expected[:, 0])) <= 1e-10 * np.max(np.abs(expected[:, 0]))
+    many = cols.copy()
+    assert solve_band_low_rank_columns(
+        band.copy(), pos, u, w, rank, many, 7, np.zeros((n2, SOLVE_COLUMNS)), np.zeros((n2, room)),
+        np.zeros((room, room)), np.zeros(room, dtype=np.int64), np.zeros(room),
+    )  # fmt: skip
+    assert np.max(np.abs(many - expected)) <= 1e-10 * np.max(np.abs(expected))

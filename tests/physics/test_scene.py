@@ -51,6 +51,8 @@ def test_ring_rejects_invalid_values(kwargs, field):
         ({"adaptive": 1}, "adaptive"),
         ({"newton_tol": 0.5}, "newton_tol"),
         ({"newton_max_iter": 0}, "newton_max_iter"),
+        ({"newton_rescue_max_iter": -1}, "newton_rescue_max_iter"),
+        ({"newton_rescue_max_iter": 201}, "newton_rescue_max_iter"),
         ({"atmospheric_pressure": -1.0}, "atmospheric_pressure"),
         ({"gas_exponent": -0.5}, "gas_exponent"),
         ({"gas_exponent": 3.5}, "gas_exponent"),

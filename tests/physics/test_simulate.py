@@ -184,7 +184,9 @@ def test_step_below_dt_min_raises_a_clear_error():
     rng = np.random.default_rng(4)
     ring = _ring(pressure=30e3, n_nodes=32, position=(0.0, 0.0))
     v0 = 5.0 * rng.standard_normal((32, 2))
-    scene = Scene(rings=[ring], gravity=0.0, dt=2e-3, dt_min=1e-3, newton_max_iter=1)
+    scene = Scene(
+        rings=[ring], gravity=0.0, dt=2e-3, dt_min=1e-3, newton_max_iter=1, newton_rescue_max_iter=0
+    )
     with pytest.raises(SimulationError, match="dt_min") as err:
         simulate(scene, 0.02, v0=v0)
     assert np.all(np.isfinite(err.value.trajectory.x))

@@ -1,11 +1,14 @@
 """The one driver: Simulation advances in pieces, actuates between them and reports its run."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
 from ballenv.physics import Ground, Ring, Scene, Simulation, simulate
 from ballenv.physics.layout import ENERGY_BUDGET, ENERGY_TOTAL
 from ballenv.physics.simulation import initial_state
+from tests.stability.invariants import audit
 
 
 def _scene(**kw):
@@ -135,3 +138,54 @@ def test_a_self_crossing_start_is_accepted_when_the_scene_ignores_self_crossing(
     x, _ = initial_state(scene)
     sim = Simulation(scene, x0=_swapped(x.copy()))
     assert np.array_equal(sim.state.x, _swapped(x.copy()))
+
+
+def _friction_cycling_scene(**kw):
+    """A soft thick ring thrown at 37 m/s into a 51-degree slope with friction 1.77, fixed steps:
+    at about 0.06 s a step's Newton iteration cycles on the friction of the arriving nodes at
+    every step size down to dt_min (soak scene 386)."""
+    ring = Ring(radius=0.21908550283754036, n_nodes=16, youngs_modulus=169672.07643971348,
+                thickness=0.05800177410329822, width=0.0826368731211833, density=1182.925071590477,
+                pressure=2423.116913858776, position=(0.1970850026117266, 0.16053791247019375),
+                velocity=(-28.480595192196738, -23.382880876318133),
+                angular_velocity=-39.403811419400036)  # fmt: skip
+    return Scene(rings=[ring], grounds=[Ground(angle=-0.887239099325383, friction=1.771691584185452)],
+                 contact="predictor_corrector", gravity=14.140211636929251, damping=5.0,
+                 rho_infinity=0.19446518285111236, dt=0.002901785277960875, gas_exponent=1.4,
+                 **kw)  # fmt: skip
+
+
+def test_newton_rescue_carries_a_run_past_a_step_that_cycles_on_friction():
+    t_end = 0.11117556721023988
+    stopped = audit(_friction_cycling_scene(newton_rescue_max_iter=0), t_end)
+    assert not stopped.reached_end and "Newton's iteration did not converge" in stopped.error
+    rescued = audit(_friction_cycling_scene(), t_end)
+    assert rescued.reached_end and rescued.problems() == []
+    assert rescued.traj.stats.newton_rescues >= 1
+    # the same run up to the stop: the rescue changes nothing before it
+    k = len(stopped.traj.t)
+    np.testing.assert_array_equal(rescued.traj.x[:k], stopped.traj.x)
+
+
+def test_a_run_that_never_stops_is_the_same_with_or_without_newton_rescue():
+    """At most three Newton corrections: many steps fail and are retried smaller, none down to
+    dt_min, so the rescue never acts: the two runs agree to the last bit."""
+    ring = Ring(radius=0.1, n_nodes=32, pressure=30e3, position=(0.0, 0.0))
+    v0 = 8.0 * np.random.default_rng(4).standard_normal((1, 32, 2))
+    settings = dict(gravity=0.0, integrator="backward_euler", dt=2e-3, adaptive=True, newton_max_iter=3)
+    runs = [
+        simulate(Scene(rings=[ring], newton_rescue_max_iter=rescue, **settings), 0.02, v0=v0)
+        for rescue in (0, 200)
+    ]
+    assert runs[0].stats.rejections["newton"] > 0 and runs[1].stats.newton_rescues == 0
+    np.testing.assert_array_equal(runs[0].x, runs[1].x)
+    np.testing.assert_array_equal(runs[0].v, runs[1].v)
+    assert runs[0].stats.newton_iterations == runs[1].stats.newton_iterations
+
+
+def test_a_failed_newton_rescue_says_so():
+    scene = replace(_friction_cycling_scene(), newton_max_iter=1, newton_rescue_max_iter=2, dt_min=1e-4)
+    sim = Simulation(scene)
+    assert not sim.advance(0.11)
+    assert "Newton's rescue failed too" in sim.failure
+    assert sim.stats().newton_rescues == 0 and np.all(np.isfinite(sim.state.x))

@@ -191,6 +191,7 @@ SCENE_FIELDS = {
     "dt_min": st.one_of(open_low(0.0, 1e-4), st.floats(1e-4, 1.0, exclude_min=True)),  # dt = 1e-4
     "newton_tol": out_of(1e-14, 1e-2),
     "newton_max_iter": out_of(1, 200, integer=True),
+    "newton_rescue_max_iter": out_of(0, 200, integer=True),
     "atmospheric_pressure": out_of(0.0, 1e7),
     "gas_exponent": out_of(0.0, 3.0),
     "ring_collision": NOT_A_BOOL,
