@@ -42,6 +42,7 @@ above tolerance at the smallest step).
 import math
 
 from .contact import FREE, frame
+from .geometry import centre_of_mass
 from .jit import kernel
 
 LIFTOFF_IMPULSE = 2.0  # contact impulse per step over sqrt(rtol) M sqrt(g R) under error control
@@ -58,22 +59,12 @@ def in_contact(state, trial):
 
 
 @kernel
-def rigid_motion(x, v):
+def rigid_momentum(x, v):
     """``(xbar, ybar, ubar, vbar, l)``: the centre of mass (m), its velocity (m/s) and the angular
     momentum about it per node mass (m^2/s) of nodes at ``x`` moving with ``v`` ((N, 2))."""
-    n = x.shape[0]
-    cx = cy = ux = uy = 0.0
-    for i in range(n):
-        cx += x[i, 0]
-        cy += x[i, 1]
-        ux += v[i, 0]
-        uy += v[i, 1]
-    cx /= n
-    cy /= n
-    ux /= n
-    uy /= n
+    cx, cy, ux, uy = centre_of_mass(x, v)
     spin = 0.0
-    for i in range(n):
+    for i in range(x.shape[0]):
         spin += (x[i, 0] - cx) * (v[i, 1] - uy) - (x[i, 1] - cy) * (v[i, 0] - ux)
     return cx, cy, ux, uy, spin
 
@@ -83,8 +74,8 @@ def doubling_norm(model, solver, r, whole, halves):
     """Ring ``r``'s scaled contact error from its state after the whole step (``whole``) and after
     two half steps (``halves``; States): at most 1 is within tolerance."""
     n = whole.x.shape[1]
-    _, _, ux0, uy0, l0 = rigid_motion(whole.x[r], whole.v[r])
-    _, _, ux1, uy1, l1 = rigid_motion(halves.x[r], halves.v[r])
+    _, _, ux0, uy0, l0 = rigid_momentum(whole.x[r], whole.v[r])
+    _, _, ux1, uy1, l1 = rigid_momentum(halves.x[r], halves.v[r])
     radius = model.radius[r]
     g = math.hypot(model.gravity[0], model.gravity[1])
     speed = solver.rtol * math.sqrt((g if g > 0.0 else 9.81) * radius)  # m/s

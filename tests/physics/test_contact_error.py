@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from ballenv.physics import Ground, Ring, Scene, Simulation
-from ballenv.physics.contact_error import LIFTOFF_IMPULSE, arrival_norm, doubling_norm, rigid_motion
+from ballenv.physics.contact_error import LIFTOFF_IMPULSE, arrival_norm, doubling_norm, rigid_momentum
 from ballenv.physics.integrator import build_solver
 from ballenv.physics.model import impulse_bounds
 from ballenv.physics.ring import total_mass
@@ -41,7 +41,7 @@ def _after(scene, h, steps):
 
 
 def _centre_velocity(state):
-    return np.array(rigid_motion(state.x[0], state.v[0])[2:4])
+    return np.array(rigid_momentum(state.x[0], state.v[0])[2:4])
 
 
 def _doubling(h, frac=1.0 / 3.0):
