@@ -50,24 +50,28 @@ class RecordedLookahead(LookaheadPump):
     def __init__(self, env):
         super().__init__(env)
         self.structure = env.unwrapped.observation_structure
+        self.config = env.unwrapped.config
         self.rows, self.curves = [], []
 
     def act(self, obs):
-        plans = self.amplitude is None or self.env_batch.task.apex_count[0] > 0
-        action = super().act(obs)
-        if plans and np.isfinite(self.candidate_errors).all():
-            self.rows.append(features(obs, self.structure))
+        self.obs = obs  # what the decision sees, if this step makes one (plan)
+        return super().act(obs)
+
+    def plan(self):
+        amplitude = super().plan()
+        if np.isfinite(self.candidate_errors).all():
+            self.rows.append(features(self.obs, self.structure, self.config.control_dt, self.config.gravity))
             self.curves.append(self.candidate_errors.copy())
-        return action
+        return amplitude
 
 
-def features(obs, structure, dt=0.01, g=9.81):
+def features(obs, structure, dt, g):
     """The decision's features: BODY (4 numbers), then SHAPE (1 + 2 + 2 + 2 + 2): the ring's spin
     (rad/s), its rotation phase ``N theta`` within one node spacing, the amplitudes of its radius'
     modes 2 and 3 relative to its mean, its mean radius (m) and mean radial velocity (m/s) (nodes
-    relative to the centre of mass), and where in its control step the ball's centre will fall to
-    one mean radius above the ground, ``t = (v_y + sqrt(v_y^2 + 2 g (y - r))) / g`` in units of
-    ``dt``, as an angle."""
+    relative to the centre of mass), and where in its control step ``dt`` (s) the ball's centre will
+    fall to one mean radius above the ground, ``t = (v_y + sqrt(v_y^2 + 2 g (y - r))) / g`` (``g``,
+    m/s^2) in units of ``dt``, as an angle."""
     target = obs[structure["target_height"]][0]
     body = [
         (target - obs[structure["last_apex"]][0]) / target, target,

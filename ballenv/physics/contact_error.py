@@ -46,6 +46,7 @@ from .geometry import centre_of_mass
 from .jit import kernel
 
 LIFTOFF_IMPULSE = 2.0  # contact impulse per step over sqrt(rtol) M sqrt(g R) under error control
+SCALE_GRAVITY = 9.81  # m/s^2: the g of the speed scale sqrt(g R) in a scene without gravity
 
 
 @kernel
@@ -78,7 +79,7 @@ def doubling_norm(model, solver, r, whole, halves):
     _, _, ux1, uy1, l1 = rigid_momentum(halves.x[r], halves.v[r])
     radius = model.radius[r]
     g = math.hypot(model.gravity[0], model.gravity[1])
-    speed = solver.rtol * math.sqrt((g if g > 0.0 else 9.81) * radius)  # m/s
+    speed = solver.rtol * math.sqrt((g if g > 0.0 else SCALE_GRAVITY) * radius)  # m/s
     e_v = math.hypot(ux1 - ux0, uy1 - uy0) / speed
     e_w = abs(l1 - l0) / (n * radius) / speed
     total = 0.0

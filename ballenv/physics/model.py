@@ -23,7 +23,7 @@ from .assembly import (
 )
 from .barrier import PAIRS_PER_NODE
 from .collision import CONTACT_COLUMNS, CONTACTS_PER_NODE
-from .contact_error import LIFTOFF_IMPULSE
+from .contact_error import LIFTOFF_IMPULSE, SCALE_GRAVITY
 from .effects import EFFECTS
 from .effects.damping import DAMPING_CENTRE_OF_MASS, DAMPING_NONE, DAMPING_RIGID
 from .ground_motion import ground_array, grounds_move, surface_array
@@ -317,7 +317,7 @@ def impulse_bounds(scene):
     only what they cannot see (a node released a step early)."""
     if scene.rtol == 0.0:
         return np.full(len(scene.rings), float(scene.impulse_tol))
-    g = float(np.hypot(*scene.gravity_vector)) or 9.81
+    g = float(np.hypot(*scene.gravity_vector)) or SCALE_GRAVITY
     factor = scene.rtol
     if scene.contact_error == "doubling":
         factor = LIFTOFF_IMPULSE * math.sqrt(scene.rtol)
