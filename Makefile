@@ -11,7 +11,7 @@ export OPENBLAS_NUM_THREADS := 1
 $(STAMP): pyproject.toml constraints.txt
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -c constraints.txt -e '.[dev,docs,peers,plot,render,train]'
+	$(PY) -m pip install --quiet -c constraints.txt -e '.[dev,docs,peers,plot,ray,render,train]'
 	touch $(STAMP)
 
 venv: $(STAMP)
