@@ -114,6 +114,29 @@ def warm_nodes(warm: Callable[[], Any]) -> WarmTime:
     return WarmTime(dict(zip(nodes, ray.get(refs), strict=True)))
 
 
+def warm_simulator(run: Callable[..., Any] | None = None) -> None:
+    """A ``warm`` for sweeps of simulations: ``run(scene, t_end)`` (default
+    :func:`ballenv.physics.simulate`) on one and on two small rings with each integrator and contact
+    method, fixed and adaptive steps, three steps each: it compiles (or loads from numba's cache) the
+    kernels a sweep of scenes calls, their energies included."""
+    from dataclasses import replace
+
+    from .physics import Ground, Ring, Scene, simulate
+
+    run = simulate if run is None else run
+    ring = Ring(radius=0.1, n_nodes=8, youngs_modulus=1e7, thickness=0.005, width=0.02, pressure=1e4)
+    pair = [replace(ring, position=(0.0, 0.2)), replace(ring, position=(0.5, 0.2))]
+    for rings in (pair[:1], pair):
+        for contact in ("mass_modification", "predictor_corrector"):
+            for integrator in ("backward_euler", "generalized_alpha"):
+                for adaptive in (False, True):
+                    scene = Scene(rings=rings, grounds=[Ground()], contact=contact, integrator=integrator,
+                                  adaptive=adaptive, dt=1e-3)  # fmt: skip
+                    result = run(scene, 3e-3)
+                    if hasattr(result, "energy"):
+                        result.energy()
+
+
 def _serial(fn, items, bar) -> Iterator[tuple[int, Any]]:
     for index, item in enumerate(items):
         result = fn(item)

@@ -1,6 +1,6 @@
 """Soak run of the stability suite (``tests/stability``): thousands of random scenes and env episodes, seeded.
 
-    python benchmarks/soak.py [--scenes 2000] [--episodes 400] [--seed 0]
+    python benchmarks/soak.py [--scenes 2000] [--episodes 400] [--seed 0] [--ray local|auto|ADDRESS]
     # prints the table, writes benchmarks/results/soak.md
 
 Scenes: drawn like ``tests/stability/test_random.py``'s valid scenes (the hard cases' ranges): one
@@ -17,6 +17,12 @@ how it ended (t_end, a documented SimulationError by reason, or anything else).
 Episodes: InflatedBall-v3 (fast preset), both action modes, 250 steps each (2.5 s) of uniform
 random, extreme (+1 / -1) or alternating-extreme actions, resets included: non-finite or
 out-of-bounds observations, nodes below the ground, simulator failures.
+
+``--ray`` runs the scenes as Ray tasks (``ballenv.cluster``: 'local' starts a cluster on this
+machine; 'auto' or an address joins a running one) with the same tallies as the serial run, each
+node's numba cache warmed first; a scene whose worker died is retried, and one lost after Ray's
+retries is listed in the report and left out of the tallies. The episodes stay in this process
+(they draw from one random stream).
 """
 
 import os
@@ -30,7 +36,8 @@ import sys  # noqa: E402
 import time  # noqa: E402
 import traceback  # noqa: E402
 from collections import Counter  # noqa: E402
-from dataclasses import replace  # noqa: E402
+from dataclasses import dataclass, replace  # noqa: E402
+from functools import partial  # noqa: E402
 
 import numpy as np  # noqa: E402
 from tqdm.auto import tqdm  # noqa: E402
@@ -38,6 +45,7 @@ from tqdm.auto import tqdm  # noqa: E402
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
+from ballenv.cluster import check_cluster, collect, run_tasks, warm_simulator  # noqa: E402
 from ballenv.envs.inflated_ball import InflatedBallEnv  # noqa: E402
 from ballenv.physics import Ground, Ring, Scene  # noqa: E402
 from ballenv.physics.ring import inflated_radius  # noqa: E402
@@ -101,8 +109,58 @@ def random_scene(rng):
     return scene, rng.uniform(0.02, 0.15)
 
 
-def soak_scenes(count, seed):
+@dataclass(frozen=True)
+class SceneOutcome:
+    """What the soak keeps of one scene's run: its audit without the trajectory (so that it pickles
+    small from a Ray worker), the time reached and the step counts the report needs; or the crash."""
+
+    audit: object = None  # tests.stability.invariants.Audit, traj dropped
+    t_reached: float = 0.0
+    energy_projected: int = 0
+    newton_rescues: int = 0
+    crash: str = ""
+    where: tuple = ()
+
+
+def run_scene(task):
+    """The soak's run of one ``(scene, t_end)`` task: :func:`audit`, or the crash if it raised
+    anything but a documented SimulationError (a failure to report, not to stop the sweep on)."""
+    scene, t_end = task
+    try:
+        result = audit(scene, t_end)
+    except Exception as exc:
+        where = tuple(traceback.format_exc().strip().splitlines()[-3:])
+        return SceneOutcome(crash=f"{type(exc).__name__}: {exc}", where=where)
+    stats = result.traj.stats
+    return SceneOutcome(
+        audit=replace(result, traj=None),
+        t_reached=float(result.traj.t[-1]),
+        energy_projected=stats.energy_projected,
+        newton_rescues=stats.newton_rescues,
+    )
+
+
+def draw_scenes(count, seed):
+    """The soak's ``count`` random ``(scene, t_end)`` tasks of ``seed``, drawn in order."""
     rng = np.random.default_rng(seed)
+    return [random_scene(rng) for _ in range(count)]
+
+
+def soak_scenes(count, seed, cluster=None):
+    """Run the soak's scenes (in this process, or as Ray tasks on ``cluster``: ballenv.cluster) and
+    tally them in scene order, so the tallies do not depend on where or in which order they ran."""
+    tasks = draw_scenes(count, seed)
+    outcomes, lost = collect(
+        run_tasks(
+            run_scene, tasks, cluster, desc="scenes", warm=partial(warm_simulator, audit), paths=[str(ROOT)]
+        ),
+        count,
+    )
+    return tally_scenes(tasks, outcomes) + (lost,)
+
+
+def tally_scenes(tasks, outcomes):
+    """The report's tallies of the scenes' outcomes (None: a task lost with its worker)."""
     tally = Counter()
     rejected = Counter()
     ends = Counter()
@@ -111,18 +169,17 @@ def soak_scenes(count, seed):
     worst = []
     crashes = []
     stops = []
-    for index in tqdm(range(count), desc="scenes", unit="scene"):
-        scene, t_end = random_scene(rng)
+    for index, ((scene, t_end), outcome) in enumerate(zip(tasks, outcomes, strict=True)):
+        if outcome is None:
+            continue
         tally["cases"] += 1
         tally[scene.integrator] += 1
-        try:
-            result = audit(scene, t_end)
-        except Exception as exc:  # anything but a documented SimulationError is a failure to report
-            ends[f"crash: {type(exc).__name__}: {exc}"[:120]] += 1
-            where = traceback.format_exc().strip().splitlines()[-3:]
-            crashes.append((index, scene, t_end, where))
-            tqdm.write(f"crash in scene {index} (t_end {t_end}): {scene}\n" + "\n".join(where))
+        if outcome.crash:
+            ends[f"crash: {outcome.crash}"[:120]] += 1
+            crashes.append((index, scene, t_end, outcome.where))
+            tqdm.write(f"crash in scene {index} (t_end {t_end}): {scene}\n" + "\n".join(outcome.where))
             continue
+        result = outcome.audit
         tally["steps"] += result.steps
         rejected.update({k: result.rejections[k] for k in REASONS})
         tally["non-finite"] += not result.finite
@@ -133,10 +190,10 @@ def soak_scenes(count, seed):
         tally["energy growth"] += grew
         tally[f"energy growth {scene.integrator}"] += grew
         tally["push-out above start"] += above_start and not grew
-        tally["projected runs"] += result.traj.stats.energy_projected > 0
-        tally["projected steps"] += result.traj.stats.energy_projected
-        tally["rescued runs"] += result.traj.stats.newton_rescues > 0
-        tally["rescued steps"] += result.traj.stats.newton_rescues
+        tally["projected runs"] += outcome.energy_projected > 0
+        tally["projected steps"] += outcome.energy_projected
+        tally["rescued runs"] += outcome.newton_rescues > 0
+        tally["rescued steps"] += outcome.newton_rescues
         if result.finite:
             growth[scene.integrator].append(result.energy_growth)
             removed[scene.integrator].append(result.energy_removed)
@@ -147,7 +204,7 @@ def soak_scenes(count, seed):
         else:
             key = next((v for k, v in FAILURE_KEYS.items() if k in result.error), None)
             ends[key if key and result.documented else f"undocumented: {result.error[:80]}"] += 1
-            stops.append((index, key or result.error[:80], float(result.traj.t[-1]), t_end, scene))
+            stops.append((index, key or result.error[:80], outcome.t_reached, t_end, scene))
     worst.sort(key=lambda w: -w[0])
     return tally, rejected, ends, growth, removed, worst, crashes, stops
 
@@ -199,9 +256,19 @@ def main():
     parser.add_argument("--scenes", type=int, default=2000)
     parser.add_argument("--episodes", type=int, default=400)
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument(
+        "--ray",
+        dest="cluster",
+        metavar="ADDRESS",
+        default=None,
+        help="run the scenes as Ray tasks: 'local' (a cluster on this machine), 'auto' or an address",
+    )
+    parser.add_argument("--out", type=pathlib.Path, default=RESULTS / "soak.md", help="the report's path")
     args = parser.parse_args()
     start = time.perf_counter()
-    tally, rejected, ends, growth, removed, worst, crashes, stops = soak_scenes(args.scenes, args.seed)
+    tally, rejected, ends, growth, removed, worst, crashes, stops, lost = soak_scenes(
+        args.scenes, args.seed, check_cluster(args.cluster)
+    )
     scene_time = time.perf_counter() - start
     episodes = soak_episodes(args.episodes, args.seed + 1)
     wall = time.perf_counter() - start
@@ -213,7 +280,10 @@ def main():
         "# Soak run (`python benchmarks/soak.py`)",
         "",
         f"Seed {args.seed}; {args.scenes} random scenes and {args.episodes} env episodes; wall time "
-        f"{wall:.0f} s ({scene_time:.0f} s scenes), numba warm from the on-disk cache.",
+        f"{wall:.0f} s ({scene_time:.0f} s scenes"
+        + (f" as Ray tasks on {args.cluster}" if args.cluster else "")
+        + "), numba warm from the on-disk cache."
+        + (f" Scenes lost with their Ray worker: {', '.join(str(t.index) for t in lost)}." if lost else ""),
         "",
         "## Random scenes",
         "",
@@ -300,8 +370,8 @@ def main():
     ]
     text = "\n".join(lines)
     print(text)
-    RESULTS.mkdir(exist_ok=True)
-    (RESULTS / "soak.md").write_text(text)
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    args.out.write_text(text)
 
 
 if __name__ == "__main__":

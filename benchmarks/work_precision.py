@@ -4,6 +4,7 @@ convergence orders in flight; restitution vs inflation pressure at several steps
 
     python benchmarks/work_precision.py          # writes benchmarks/results/work_precision.md and .png
     python benchmarks/work_precision.py --quick  # a few points per curve (what the tests run)
+    python benchmarks/work_precision.py --ray local  # its runs as Ray tasks (ballenv.cluster)
 
 The ball is the env's (R = 0.12 m, E = 10 MPa, h = 2 mm, b = 2 cm, 30 kPa gauge, friction 0.5),
 released at rest with its centre at 1 m:
@@ -34,11 +35,13 @@ import time  # noqa: E402
 
 import numpy as np  # noqa: E402
 
+from ballenv.cluster import check_cluster, collect, run_tasks, warm_simulator  # noqa: E402
 from ballenv.physics import Ground, Ring, Scene, simulate  # noqa: E402
 from ballenv.physics.presets import FIDELITY_PRESETS, with_fidelity  # noqa: E402
 from ballenv.physics.simulation import SimulationError, initial_state  # noqa: E402
 
-RESULTS = pathlib.Path(__file__).parent / "results"
+ROOT = pathlib.Path(__file__).resolve().parent.parent  # the checkout: Ray workers import from it
+RESULTS = ROOT / "benchmarks" / "results"
 GRID_DT = 1e-3  # s: the grid of the centre-of-mass trajectory error, and the record interval of fixed steps
 SLOPE = math.radians(30.0)
 SCENES = {"bounce": 0.9, "slope": 0.9, "bouncing": 3.0}  # name -> t_end (s)
@@ -285,27 +288,26 @@ def preset_scene(name, preset):
     return with_fidelity(base_scene(name), preset)
 
 
-def sweep(name, ref, quick=False, repeats=3, progress=None):
-    """{curve: [(point, Run)]} of scene ``name`` with errors against ``ref`` (a Run), presets included."""
+def sweep_jobs(name, quick=False, repeats=3):
+    """The runs of scene ``name``'s sweep: ``[(curve, point, scene, t_end, repeats)]``, curve by curve,
+    the presets last (curve "presets", point: the preset's name)."""
     t_end = SCENES[name]
+    jobs = [
+        (curve, point, configured(base_scene(name), **numerics), t_end, repeats)
+        for curve, points in curves(name, quick).items()
+        for point, numerics in points
+    ]
+    return jobs + [("presets", p, preset_scene(name, p), t_end, repeats) for p in FIDELITY_PRESETS]
+
+
+def sweep(points, results, ref):
+    """{curve: [(point, Run)]} of a scene's sweep from its ``[(curve, point)]`` (:func:`sweep_jobs`)
+    and their Runs, with errors against ``ref`` (a Run)."""
     out = {}
-    for curve, points in curves(name, quick).items():
-        out[curve] = []
-        for point, numerics in points:
-            r = run(configured(base_scene(name), **numerics), t_end, repeats)
-            if r.obs is not None:
-                r.errors = errors(r.obs, ref.obs)
-            out[curve].append((point, r))
-            if progress is not None:
-                progress.update()
-    out["presets"] = []
-    for preset in FIDELITY_PRESETS:
-        r = run(preset_scene(name, preset), t_end, repeats)
+    for (curve, point), r in zip(points, results, strict=True):
         if r.obs is not None:
             r.errors = errors(r.obs, ref.obs)
-        out["presets"].append((preset, r))
-        if progress is not None:
-            progress.update()
+        out.setdefault(curve, []).append((point, r))
     return out
 
 
@@ -388,24 +390,26 @@ def _fmt(x, spec=".1e"):
     return "-" if x is None or not np.isfinite(x) else format(x, spec)
 
 
-def references(progress=None):
-    """{scene: (reference Run, {check label: (Run, errors vs reference)}, uncertainty per metric)}."""
+def reference_check(name, label):
+    """``(label, Run)`` of reference check ``label`` of scene ``name`` (REFERENCE_CHECKS), or of
+    FALLBACK_CHECK if that run fails."""
+    r = reference(name, **REFERENCE_CHECKS[label])
+    if r.obs is None:
+        label, override = FALLBACK_CHECK
+        r = reference(name, **override)
+    return label, r
+
+
+def references(ref_runs, check_runs):
+    """{scene: (reference Run, {check label: (Run, errors vs reference)}, uncertainty per metric)}
+    from the reference runs {scene: Run} and the checks' runs {scene: [(label, Run)]}."""
     out = {}
-    for name in SCENES:
-        ref = reference(name)
-        checks = {}
-        for label, override in REFERENCE_CHECKS.items():
-            r = reference(name, **override)
-            if r.obs is None:
-                label, override = FALLBACK_CHECK
-                r = reference(name, **override)
-            checks[label] = (r, errors(r.obs, ref.obs) if r.obs is not None else None)
-            if progress is not None:
-                progress.update()
-        unc = {m: max(e[m] for _, e in checks.values() if e is not None) for m in METRICS}
+    for name, ref in ref_runs.items():
+        checks = {
+            label: (r, errors(r.obs, ref.obs) if r.obs is not None else None) for label, r in check_runs[name]
+        }
+        unc = {m: max(e[m] for _, e in checks.values() if e is not None) for m in METRICS} if checks else {}
         out[name] = (ref, checks, unc)
-        if progress is not None:
-            progress.update()
     return out
 
 
@@ -430,38 +434,80 @@ def balanced_vs_backward_euler(bounce_runs):
     }
 
 
-def main(argv=None):
-    from tqdm.auto import tqdm
+def study_jobs(quick):
+    """Every run of the study, each independent of the others: ``[(key, function, args)]``."""
+    names = ["bounce"] if quick else list(SCENES)
+    jobs = [(("reference", name), reference, (name,)) for name in names]
+    if not quick:
+        jobs += [
+            (("check", name), reference_check, (name, label)) for name in names for label in REFERENCE_CHECKS
+        ]
+    for name in names:
+        jobs += [
+            (("sweep", name, curve, point), run, rest) for curve, point, *rest in sweep_jobs(name, quick)
+        ]
+    jobs += [(("flight", i), flight_order, (i,)) for i in INTEGRATORS]
+    if not quick:
+        jobs += [(("decay", dt), vibration_decay, (dt,)) for dt in DECAY_DTS]
+        jobs += [
+            (("cor", label), restitution, (p, COR_SETTINGS[label]))
+            for label in COR_SETTINGS
+            for p in PRESSURES
+        ]
+    return names, jobs
 
+
+def call(job):
+    """The result of one job of :func:`study_jobs` (a Ray task's function: one argument)."""
+    _, function, args = job
+    return function(*args)
+
+
+def flight_order(integrator):
+    """``(dts, errors, fitted order)`` of ``integrator`` in flight."""
+    dts = np.array([1e-4, 5e-5, 2.5e-5, 1.25e-5])
+    errs = flight_errors(integrator, dts)
+    return dts, errs, fitted_order(dts, errs)
+
+
+def assemble(names, jobs, results, quick):
+    """The study's tables (references, sweeps, orders, restitution, decay) from its jobs' results."""
+    by_key = {}
+    for (key, *_), result in zip(jobs, results, strict=True):
+        by_key.setdefault(key[:2], []).append(result)
+    ref_runs = {name: by_key[("reference", name)][0] for name in names}
+    refs = references(ref_runs, {name: by_key.get(("check", name), []) for name in names})
+    points = {name: [key[2:] for key, *_ in jobs if key[:2] == ("sweep", name)] for name in names}
+    runs = {name: sweep(points[name], by_key[("sweep", name)], ref_runs[name]) for name in names}
+    orders = {i: by_key[("flight", i)][0] for i in INTEGRATORS}
+    decay = {dt: by_key[("decay", dt)][0] for dt in DECAY_DTS} if not quick else {}
+    cor = {label: by_key[("cor", label)] for label in COR_SETTINGS} if not quick else {}
+    return refs, runs, orders, cor, decay
+
+
+def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--quick", action="store_true", help="a few points per curve, single bounce only")
+    parser.add_argument(
+        "--ray",
+        dest="cluster",
+        metavar="ADDRESS",
+        default=None,
+        help="run the study's runs as Ray tasks: 'local' (a cluster on this machine), 'auto' or an address",
+    )
     args = parser.parse_args(argv)
     RESULTS.mkdir(exist_ok=True)
-    names = ["bounce"] if args.quick else list(SCENES)
-    n_runs = sum(sum(len(v) for v in curves(n, args.quick).values()) + len(FIDELITY_PRESETS) for n in names)
-    n_runs += 3 * len(names) + (0 if args.quick else len(PRESSURES) * len(COR_SETTINGS) + len(DECAY_DTS) + 1)
+    names, jobs = study_jobs(args.quick)
     start = time.perf_counter()
-    with tqdm(total=n_runs, desc="work-precision") as bar:
-        refs = references(bar) if not args.quick else {"bounce": (reference("bounce"), {}, {})}
-        runs = {name: sweep(name, refs[name][0], args.quick, progress=bar) for name in names}
-        orders = {}
-        for integrator in INTEGRATORS:
-            dts = np.array([1e-4, 5e-5, 2.5e-5, 1.25e-5])
-            errs = flight_errors(integrator, dts)
-            orders[integrator] = (dts, errs, fitted_order(dts, errs))
-        bar.update()
-        cor, decay = {}, {}
-        if not args.quick:
-            for dt in DECAY_DTS:
-                decay[dt] = vibration_decay(dt)
-                bar.update()
-            for label, numerics in COR_SETTINGS.items():
-                cor[label] = []
-                for p in PRESSURES:
-                    cor[label].append(restitution(p, numerics))
-                    bar.update()
+    outcomes = run_tasks(
+        call, jobs, check_cluster(args.cluster), desc="work-precision", warm=warm_simulator, paths=[str(ROOT)]
+    )
+    results, lost = collect(outcomes, len(jobs))
+    if lost:
+        raise SystemExit(f"runs lost with their Ray worker after Ray's retries: {[t.index for t in lost]}")
     elapsed = time.perf_counter() - start
-    text = report(refs, runs, orders, cor, decay, elapsed, args.quick)
+    refs, runs, orders, cor, decay = assemble(names, jobs, results, args.quick)
+    text = report(refs, runs, orders, cor, decay, elapsed, args.quick, args.cluster)
     suffix = "_quick" if args.quick else ""
     (RESULTS / f"work_precision{suffix}.md").write_text(text)
     print(text)
@@ -469,12 +515,18 @@ def main(argv=None):
     plot_extras(runs["bounce"], refs["bounce"], orders, cor, RESULTS / f"work_precision_pareto{suffix}.png")
 
 
-def report(refs, runs, orders, cor, decay, elapsed, quick):
+def report(refs, runs, orders, cor, decay, elapsed, quick, cluster=None):
     lines = [
         "# Work-precision",
         "",
         f"Generated by `python benchmarks/work_precision.py{' --quick' if quick else ''}` in "
-        f"{elapsed / 60:.1f} min (2 cores, numba warm, OPENBLAS_NUM_THREADS=1; wall time = median of 3 "
+        f"{elapsed / 60:.1f} min ("
+        + (
+            f"as Ray tasks on {cluster}, each run's wall time taken beside the other workers; "
+            if cluster
+            else ""
+        )
+        + "2 cores, numba warm, OPENBLAS_NUM_THREADS=1; wall time = median of 3 "
         "repeats, 1 for runs over 2 s). N = 64 and mass-modification contact unless a row says otherwise; "
         "adaptive runs take dt <= 1e-2 s. Errors against the scene's reference. GA = generalized-alpha "
         "(rho_infinity 0.9), BE = backward Euler, MM / PC = mass-modification / predictor-corrector.",

@@ -30,12 +30,14 @@ from .library import SceneResult
 
 @dataclass(frozen=True)
 class SceneInfo:
-    """A registered scene: ``run(fidelity, reduced, progress) -> SceneResult``."""
+    """A registered scene: ``run(fidelity, reduced, progress) -> SceneResult``; with ``grid``, it
+    also takes ``cluster`` and runs its parameter grid as tasks of :func:`ballenv.cluster.run_tasks`."""
 
     name: str
     figure: str
     summary: str
     run: object
+    grid: bool = False
 
 
 SCENES = {
@@ -54,7 +56,7 @@ SCENES = {
                   library.slope_spin),
         SceneInfo("two-balls", "-", "two balls colliding in flight", library.two_balls),
         SceneInfo("vibrating-plate", "-", "a ball on a vibrating plate: apex heights against Gamma",
-                  library.vibrating_plate),
+                  library.vibrating_plate, grid=True),
         SceneInfo("rotating-drum", "-", "a ribbon loop rolling in a rotating drum: aspect ratio vs speed",
                   library.rotating_drum),
     )
@@ -69,9 +71,13 @@ def get(name):
         raise ValueError(f"unknown scene {name!r}: the scenes are {', '.join(SCENES)}") from None
 
 
-def run(name, fidelity="balanced", reduced=False, progress=False):
-    """Run scene ``name`` (see the module table) and return its :class:`SceneResult`."""
-    return get(name).run(fidelity=fidelity, reduced=reduced, progress=progress)
+def run(name, fidelity="balanced", reduced=False, progress=False, cluster=None):
+    """Run scene ``name`` (see the module table) and return its :class:`SceneResult`; a scene with a
+    parameter grid (``SceneInfo.grid``) runs it on ``cluster`` (:func:`ballenv.cluster.run_tasks`:
+    None, "local", "auto" or an address), the others here."""
+    info = get(name)
+    grid = {"cluster": cluster} if info.grid else {}
+    return info.run(fidelity=fidelity, reduced=reduced, progress=progress, **grid)
 
 
 __all__ = ["SCENES", "SceneInfo", "SceneResult", "get", "run"]

@@ -2,6 +2,7 @@
 
     python -m ballenv.scenes --list
     python -m ballenv.scenes NAME [NAME ...] --out DIR [--fidelity balanced] [--reduced] [--video mp4]
+    python -m ballenv.scenes vibrating-plate --out DIR --ray local  # its grid as Ray tasks
 
 Writes, in DIR: ``NAME.png`` (the figure), ``NAME.gif`` and ``NAME.mp4`` (the video: a GIF for pages
 that play only GIFs inline, the MP4 in full colour), ``NAME.json`` (parameters and measured numbers,
@@ -17,8 +18,9 @@ import re
 import sys
 import time
 
+from ..cluster import check_cluster
 from ..video import FORMATS
-from . import SCENES, get
+from . import SCENES, get, run
 
 
 def _slug(label):
@@ -36,11 +38,12 @@ def _jsonable(value):
 
 
 def run_one(
-    name, out, fidelity="balanced", reduced=False, video=FORMATS, save=True, frames=120, progress=True
-):
-    """Run scene ``name`` and write its files into ``out``: the figure, the video in each format of
-    ``video`` ("gif", "mp4"; none: ``()``), the numbers and, with ``save``, the trajectories.
-    Returns the written paths."""
+    name, out, fidelity="balanced", reduced=False, video=FORMATS, save=True, frames=120, progress=True,
+    cluster=None,
+):  # fmt: skip
+    """Run scene ``name`` (its parameter grid, if it has one, on ``cluster``: :func:`.run`) and
+    write its files into ``out``: the figure, the video in each format of ``video`` ("gif", "mp4";
+    none: ``()``), the numbers and, with ``save``, the trajectories. Returns the written paths."""
     from .animate import write_videos
     from .figures import plot
 
@@ -48,7 +51,7 @@ def run_one(
     out = pathlib.Path(out)
     out.mkdir(parents=True, exist_ok=True)
     start = time.perf_counter()
-    result = info.run(fidelity=fidelity, reduced=reduced, progress=progress)
+    result = run(name, fidelity=fidelity, reduced=reduced, progress=progress, cluster=cluster)
     wall = time.perf_counter() - start
     paths = [plot(result, out / f"{name}.png")]
     if video and result.animate:
@@ -91,6 +94,14 @@ def main(argv=None):
     parser.add_argument("--no-video", action="store_true", help="write no video")
     parser.add_argument("--no-trajectories", action="store_true", help="do not save the .npz trajectories")
     parser.add_argument("--frames", type=int, default=120, help="frames of the video (default 120)")
+    parser.add_argument(
+        "--ray",
+        dest="cluster",
+        metavar="ADDRESS",
+        default=None,
+        help="run the scenes' parameter grids as Ray tasks: 'local' (a cluster on this machine), 'auto' "
+        "or a cluster's address (pip install 'ballenv[ray]')",
+    )
     args = parser.parse_args(argv)
     if args.list or not args.names:
         width = max(len(n) for n in SCENES)
@@ -114,6 +125,7 @@ def main(argv=None):
             video=() if args.no_video else FORMATS if args.video == "both" else (args.video,),
             save=not args.no_trajectories,
             frames=args.frames,
+            cluster=check_cluster(args.cluster),
         )
         for p in paths:
             print(f"wrote {p}")

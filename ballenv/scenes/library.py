@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..cluster import collect, run_tasks
 from ..physics import Drum, Ground, Ring, Scene, Simulation, SimulationError, simulate
 from ..physics.events import event_list
 from ..physics.presets import with_fidelity
@@ -594,7 +595,15 @@ def plate_bounces(gamma, restitution, fidelity="balanced", progress=False, perio
     return (traj, *late_bounces(traj, settle / f, plate, touching))
 
 
-def vibrating_plate(fidelity="balanced", reduced=False, progress=False):
+def plate_point(task):
+    """:func:`plate_bounces` of one ``(gamma, restitution, fidelity, reduced)`` point of the
+    vibrating plate's grid (a task of :func:`ballenv.cluster.run_tasks`)."""
+    gamma, restitution, fidelity, reduced = task
+    return plate_bounces(gamma, restitution, fidelity, False, periods=40 if reduced else 60,
+                         settle=20 if reduced else 30)  # fmt: skip
+
+
+def vibrating_plate(fidelity="balanced", reduced=False, progress=False, cluster=None):
     """The bouncing ball on a vibrating plate: a bifurcation diagram against the plate's acceleration.
 
     A ball (R = 0.1 m, h = 2 mm, E = 10 MPa, p = 30 kPa, damping 800 1/s: a lossy ball) above a
@@ -605,16 +614,24 @@ def vibrating_plate(fidelity="balanced", reduced=False, progress=False):
     phases of the bounces of the last 30 periods, their period (:func:`bounce_period`). Against the
     point-particle map (:func:`bouncing_ball_thresholds`) with the restitution ``e`` the ring shows
     when dropped onto a fixed floor from the period-1 bounce height ``g / (8 f^2)`` (m). (Dropped
-    from rest instead, the ball falls into a low, sticking period-1 orbit, not the map's.)
+    from rest instead, the ball falls into a low, sticking period-1 orbit, not the map's.) The
+    values of Gamma run as tasks of :func:`ballenv.cluster.run_tasks` on ``cluster`` (None: here,
+    one after the other; a value lost with its Ray worker after Ray's retries is a RuntimeError).
     """
     gammas = [1.3, 1.5] if reduced else [round(1.0 + 0.025 * k, 3) for k in range(121)]
     drop = G / (8.0 * PLATE_FREQUENCY**2)
     e, drop_traj = drop_restitution(PLATE_BALL, PLATE_DAMPING, drop, fidelity, progress)
     exist, doubling = bouncing_ball_thresholds(e)
     heights, phases, periods, trajectories = {}, {}, {}, {"drop": drop_traj}
-    for gamma in gammas:
-        traj, h, phi = plate_bounces(gamma, e, fidelity, progress, periods=40 if reduced else 60,
-                                     settle=20 if reduced else 30)  # fmt: skip
+    tasks = [(gamma, e, fidelity, reduced) for gamma in gammas]
+    points, lost = collect(
+        run_tasks(plate_point, tasks, cluster, desc="Gamma", progress=progress), len(tasks)
+    )
+    if lost:
+        raise RuntimeError(
+            f"Gamma {', '.join(str(gammas[t.index]) for t in lost)} lost with their Ray worker"
+        )
+    for gamma, (traj, h, phi) in zip(gammas, points, strict=True):
         heights[gamma], phases[gamma] = h.tolist(), phi.tolist()
         periods[gamma] = bounce_period(h)
         trajectories[f"Gamma {gamma:g}"] = traj

@@ -1,0 +1,144 @@
+"""A sweep on a local Ray cluster: speed-up from one to two workers, the overhead per task, and the
+projected cost of the full soak on a 64-core cluster.
+
+    python benchmarks/cluster_scaling.py [--scenes 200]   # writes benchmarks/results/cluster_scaling.md
+
+The sweep is the soak's first ``--scenes`` random scenes (``benchmarks/soak.py``), run three ways
+through ``ballenv.cluster.run_tasks``: in this process, and on a local Ray cluster of one and of two
+workers (``num_cpus``), each started fresh (its start-up timed apart), with each node's numba cache
+warmed first (``ballenv.cluster.warm_simulator``, timed apart; the cache on disk is warm). The
+tallies of the three runs must be equal. The overhead per task: 400 tasks that return at once, on
+each cluster (wall time x workers / 400). The projection for the full soak (1,800 scenes) on ``W``
+workers: its work is taken as 1,800 times the mean time per scene measured here, and the time is at
+least the longest single scene (a task runs on one core):
+``max(work / W, longest) + overhead * 1800 / W``.
+"""
+
+import argparse
+import pathlib
+import sys
+import time
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+import ray  # noqa: E402
+
+from ballenv.cluster import collect, connect, run_tasks, warm_simulator  # noqa: E402
+from tests.stability.invariants import audit  # noqa: E402
+
+RESULTS = ROOT / "benchmarks" / "results"
+SOAK_SCENES = 1800
+CLUSTER_CORES = 64
+LONGEST_KNOWN = ("scene 1665 of the full soak (two N = 256 rings, 68 mm walls), measured alone", 270.0)
+
+
+def timed_scene(task):
+    """The soak's run of one scene and its time in the worker (s)."""
+    from soak import run_scene
+
+    start = time.perf_counter()
+    outcome = run_scene(task)
+    return outcome, time.perf_counter() - start
+
+
+def nothing(x):
+    return x
+
+
+def one_way(tasks, workers):
+    """Run the sweep in this process (``workers`` 0) or on a fresh local cluster of ``workers``:
+    {outcomes, per-task times, sweep wall, start-up, warm-up, overhead per task}."""
+    out = {"startup": 0.0, "warm": 0.0, "overhead": float("nan")}
+    cluster = None
+    if workers:
+        start = time.perf_counter()
+        connect("local", num_cpus=workers, paths=[str(ROOT), str(ROOT / "benchmarks")])
+        out["startup"] = time.perf_counter() - start
+        start = time.perf_counter()
+        list(run_tasks(nothing, [0] * workers, "local", progress=False, warm=lambda: warm_simulator(audit)))
+        out["warm"] = time.perf_counter() - start
+        start = time.perf_counter()
+        list(run_tasks(nothing, list(range(400)), "local", progress=False))
+        out["overhead"] = (time.perf_counter() - start) * workers / 400
+        cluster = "local"
+    else:
+        start = time.perf_counter()
+        warm_simulator(audit)
+        out["warm"] = time.perf_counter() - start
+    start = time.perf_counter()
+    results, lost = collect(run_tasks(timed_scene, tasks, cluster, desc=f"{workers} workers"), len(tasks))
+    out["sweep"] = time.perf_counter() - start
+    if lost:
+        raise SystemExit(f"scenes lost with their worker: {[t.index for t in lost]}")
+    out["outcomes"] = [r[0] for r in results]
+    out["times"] = [r[1] for r in results]
+    if workers:
+        ray.shutdown()
+    return out
+
+
+def projection(times, overhead, workers):
+    """Projected wall time (s) of the full soak on ``workers`` cores and what bounds it."""
+    work = SOAK_SCENES * sum(times) / len(times)
+    longest = max(max(times), LONGEST_KNOWN[1])
+    spread = work / workers
+    return max(
+        spread, longest
+    ) + overhead * SOAK_SCENES / workers, "longest scene" if longest > spread else "work"
+
+
+def report(args, runs, soak):
+    serial, one, two = runs
+    tallies = [soak.tally_scenes(soak.draw_scenes(args.scenes, 0), r["outcomes"])[:3] for r in runs]
+    same = tallies[0] == tallies[1] == tallies[2]
+    times = serial["times"]
+    lines = [
+        "# A sweep on a local Ray cluster",
+        "",
+        f"`python benchmarks/cluster_scaling.py --scenes {args.scenes}` (ray {ray.__version__}; this "
+        "machine's 2 cores; numba's cache on disk warm). The sweep: the soak's first "
+        f"{args.scenes} scenes; tallies of the three runs {'equal' if same else 'DIFFERENT'}.",
+        "",
+        "| run | sweep wall (s) | speed-up over one worker | cluster start (s) | warm-up (s) "
+        "| overhead per task (ms) |",
+        "|---|---:|---:|---:|---:|---:|",
+        f"| in this process | {serial['sweep']:.1f} | - | - | {serial['warm']:.1f} | - |",
+        f"| Ray, 1 worker | {one['sweep']:.1f} | 1.00 | {one['startup']:.1f} | {one['warm']:.1f} "
+        f"| {1e3 * one['overhead']:.2f} |",
+        f"| Ray, 2 workers | {two['sweep']:.1f} | {one['sweep'] / two['sweep']:.2f} | {two['startup']:.1f} "
+        f"| {two['warm']:.1f} | {1e3 * two['overhead']:.2f} |",
+        "",
+        f"Per scene (in this process): mean {1e3 * sum(times) / len(times):.0f} ms, longest "
+        f"{max(times):.1f} s (scene {times.index(max(times))}); the two workers' sweep cannot end "
+        "before its longest scene.",
+        "",
+        f"Projected full soak ({SOAK_SCENES} scenes; work = {SOAK_SCENES} x the mean above = "
+        f"{SOAK_SCENES * sum(times) / len(times) / 60:.1f} min of one core; longest scene at least "
+        f"{LONGEST_KNOWN[1]:.0f} s, {LONGEST_KNOWN[0]}):",
+        "",
+        "| workers | projected wall | bound by |",
+        "|---:|---:|---|",
+    ]
+    for workers in (1, 2, CLUSTER_CORES):
+        wall, bound = projection(times, two["overhead"], workers)
+        lines.append(f"| {workers} | {wall / 60:.1f} min | {bound} |")
+    return "\n".join(lines) + "\n"
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--scenes", type=int, default=200)
+    args = parser.parse_args()
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    import soak
+
+    tasks = soak.draw_scenes(args.scenes, 0)
+    runs = [one_way(tasks, workers) for workers in (0, 1, 2)]
+    text = report(args, runs, soak)
+    print(text)
+    (RESULTS / "cluster_scaling.md").write_text(text)
+
+
+if __name__ == "__main__":
+    main()
