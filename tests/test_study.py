@@ -1,4 +1,5 @@
-"""agents.study: the interquartile mean, its two-level bootstrap interval, and a tiny study end to end."""
+"""agents.study: the interquartile mean, its two-level bootstrap interval, a tiny study end to end,
+serially and on a local Ray cluster."""
 
 import json
 
@@ -57,3 +58,24 @@ def test_a_tiny_study_runs_end_to_end(tmp_path, capsys):
     assert longer["episode_apex_errors"][:2] == stored["episode_apex_errors"]  # the same first episodes
     rows = json.loads((tmp_path / "ppo_pressure.json").read_text())
     assert rows[0]["episodes"] == 6 and rows[1]["episodes"] == 3
+
+
+def test_seeds_trained_as_ray_tasks_give_the_serial_results(tmp_path, local_ray):
+    """Two seeds with two envs each (one process per env, as the serial run) trained as Ray tasks:
+    the same held-out scores, learning curves and table as one after the other in this process."""
+    argv = [
+        "--seeds", "0", "1", "--episodes", "2", "--env-kwargs", json.dumps(SHORT), "--timesteps", "256",
+        "--n-envs", "2", "--eval-freq", "128", "--eval-episodes", "1",
+        "--hyperparams", json.dumps({"n_steps": 64, "batch_size": 64, "n_epochs": 1}),
+    ]  # fmt: skip
+    main([*argv, "--out", str(tmp_path / "serial")])
+    main([*argv, "--out", str(tmp_path / "ray"), "--cluster", "local"])
+    for seed in (0, 1):
+        serial, ray = (tmp_path / where / f"ppo_pressure_seed{seed}" for where in ("serial", "ray"))
+        scores = [json.loads((run / "scores.json").read_text()) for run in (serial, ray)]
+        assert scores[1] == scores[0]
+        curves = np.load(serial / "evaluations.npz"), np.load(ray / "evaluations.npz")
+        assert curves[0]["timesteps"].size == 2
+        np.testing.assert_array_equal(curves[1]["results"], curves[0]["results"])
+    rows = [json.loads((tmp_path / where / "ppo_pressure.json").read_text()) for where in ("serial", "ray")]
+    assert rows[1] == rows[0] and rows[1][0]["runs"] == 2
