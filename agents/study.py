@@ -32,12 +32,11 @@ used: its pin ``arch < 8`` does not import beside pandas 3.
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import functools
 import json
 import pathlib
 from collections.abc import Sequence
-from dataclasses import asdict
+from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
@@ -100,7 +99,7 @@ def table(rows: Sequence[dict[str, Any]]) -> str:
     return "\n".join(lines)
 
 
-@dataclasses.dataclass(frozen=True)
+@dataclass(frozen=True)
 class SeedJob:
     """One training seed of a study as plain data (a Ray task's argument): train it into ``out``
     unless its folder holds scores, then score its best model on ``episodes`` held-out episodes of
@@ -116,7 +115,7 @@ class SeedJob:
     train_args: tuple[str, ...] = ()
 
 
-@dataclasses.dataclass(frozen=True)
+@dataclass(frozen=True)
 class SeedResult:
     """What a seed's task returns: its run folder (on the machine that trained it), its held-out
     score and its learning curve (the periodic evaluations' env steps and mean returns)."""
