@@ -6,7 +6,7 @@ import json
 import numpy as np
 import pytest
 
-from agents.study import bootstrap_iqm, iqm, main
+from agents.study import bootstrap_iqm, build_parser, iqm, main, train_seeds
 
 SHORT = {"max_episode_steps": 60}
 
@@ -79,3 +79,29 @@ def test_seeds_trained_as_ray_tasks_give_the_serial_results(tmp_path, local_ray)
         np.testing.assert_array_equal(curves[1]["results"], curves[0]["results"])
     rows = [json.loads((tmp_path / where / "ppo_pressure.json").read_text()) for where in ("serial", "ray")]
     assert rows[1] == rows[0] and rows[1][0]["runs"] == 2
+
+
+def test_a_seed_lost_with_its_worker_is_left_out_and_named(monkeypatch, capsys):
+    """Ray gave up on seed 1's task (its worker died on every try): the study goes on with seed 0's
+    result and says which seed is missing; with every seed lost there is nothing to compare."""
+    import ballenv.cluster
+    from ballenv.cluster import TaskLost
+
+    def outcomes(fn, jobs, cluster, **options):
+        assert cluster == "auto" and [job.seed for job in jobs] == [0, 1]
+        yield 1, TaskLost(1, "WorkerCrashedError: the worker died")
+        yield 0, "seed 0's result"
+
+    monkeypatch.setattr(ballenv.cluster, "run_tasks", outcomes)
+    args, rest = build_parser().parse_known_args(["--seeds", "0", "1", "--cluster", "auto"])
+    args.train_args = rest
+    assert train_seeds(args, {"action_mode": "pressure"}) == ["seed 0's result"]
+    assert (
+        "seed 1 left out: its task was lost (WorkerCrashedError: the worker died)" in capsys.readouterr().out
+    )
+    monkeypatch.setattr(
+        ballenv.cluster, "run_tasks", lambda fn, jobs, cluster, **o: iter([(0, TaskLost(0, "x"))])
+    )
+    args.seeds = [0]
+    with pytest.raises(RuntimeError, match=r"every training seed of \[0\] was lost"):
+        train_seeds(args, {"action_mode": "pressure"})
