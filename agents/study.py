@@ -5,6 +5,7 @@ episodes, interquartile mean (IQM) with bootstrap confidence intervals, learning
     python -m agents.study --algo ppo --action-mode paddle --timesteps 400000 --out runs/study
     python -m agents.study --seeds 0 --episodes 2 --env-kwargs '{"max_episode_steps": 60}' \
         --timesteps 512 --n-envs 1 --hyperparams '{"n_steps": 64}'     # train.py options pass through
+    python -m agents.study --seeds 0 1 2 3 --cluster local      # the seeds as Ray tasks (or auto, host:6379)
 
 Each seed trains with ``agents.train`` into ``{out}/{algo}_{mode}_seed{k}`` (a folder that already
 holds ``scores.json`` is reused, so an interrupted study resumes); its best model is scored on the
@@ -12,6 +13,13 @@ held-out episodes (seeds 10,000 on), and so are the tuned heuristic and random a
 study with more ``--episodes`` scores the trained models again, without training them. Writes
 ``{out}/{algo}_{mode}.md`` (the table) and ``{out}/{algo}_{mode}.png`` (learning curves, the
 baselines as lines).
+
+With ``--cluster``, each seed is one Ray task (``ballenv.cluster.run_tasks``) that trains it and
+scores it on the held-out episodes; the baselines are scored here. A task runs its seed as the
+serial study does (``--vec-env subproc``: one process per env, torch on one thread), so the same
+seeds give the same scores, curves and table. Its run folder is written under ``--out`` on the
+machine that ran it (a folder shared by the nodes keeps them all in one place); what the table and
+the plot need comes back with the task's result.
 
 Statistics: each episode's apex error (``agents.evaluate``; missed apexes count 1); the IQM is the
 mean of the middle 50 % of the episodes pooled over runs; its 95 % interval comes from a stratified
@@ -24,17 +32,18 @@ used: its pin ``arch < 8`` does not import beside pandas 3.
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import pathlib
 from collections.abc import Sequence
-from dataclasses import asdict
+from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from .evaluate import Score, evaluate, parse_env_kwargs
-from .train import task_env_kwargs
+from .train import add_cluster_argument, task_env_kwargs
 
 RESAMPLES = 2000
 
@@ -90,37 +99,103 @@ def table(rows: Sequence[dict[str, Any]]) -> str:
     return "\n".join(lines)
 
 
-def train_seed(args: argparse.Namespace, seed: int) -> pathlib.Path:
-    """The run folder of ``seed``, trained now unless it holds scores already."""
+@dataclass(frozen=True)
+class SeedJob:
+    """One training seed of a study as plain data (a Ray task's argument): train it into ``out``
+    unless its folder holds scores, then score its best model on ``episodes`` held-out episodes of
+    the env of ``env_kwargs``. ``train_args`` go to ``agents.train`` after the study's own."""
+
+    algo: str
+    action_mode: str
+    seed: int
+    timesteps: int | None
+    episodes: int
+    out: pathlib.Path
+    env_kwargs: dict[str, Any]
+    train_args: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class SeedResult:
+    """What a seed's task returns: its run folder (on the machine that trained it), its held-out
+    score and its learning curve (the periodic evaluations' env steps and mean returns)."""
+
+    run: pathlib.Path
+    score: Score
+    steps: NDArray[np.int64]
+    returns: NDArray[np.float64]
+
+
+def run_seed(job: SeedJob) -> SeedResult:
+    """Train the seed of ``job`` (or reuse its run), score it on the held-out episodes; one thread
+    for torch, as in ``agents.train``, so that the tasks sharing a machine do not oversubscribe it."""
+    import torch
+
+    torch.set_num_threads(1)
+    run = train_seed(job)
+    curve = np.load(run / "evaluations.npz")
+    score = heldout_score(job, run)
+    return SeedResult(run, score, curve["timesteps"], curve["results"].mean(axis=1))
+
+
+def train_seed(job: SeedJob) -> pathlib.Path:
+    """The run folder of ``job``'s seed, trained now unless it holds scores already."""
     from .train import parse_args, train
 
-    run = args.out / f"{args.algo}_{args.action_mode}_seed{seed}"
+    run = job.out / f"{job.algo}_{job.action_mode}_seed{job.seed}"
     if (run / "scores.json").exists():
         return run
     argv = [
-        "--algo", args.algo, "--action-mode", args.action_mode, "--vec-env", "subproc", "--seed", str(seed),
-        "--log-dir", str(args.out), "--no-baselines", "--final-episodes", str(args.episodes),
-    ] + (["--total-timesteps", str(args.timesteps)] if args.timesteps else []) + args.train_args  # fmt: skip
-    return train(parse_args(argv))
+        "--algo", job.algo, "--action-mode", job.action_mode, "--vec-env", "subproc",
+        "--seed", str(job.seed), "--log-dir", str(job.out), "--no-baselines",
+        "--final-episodes", str(job.episodes),
+    ] + (["--total-timesteps", str(job.timesteps)] if job.timesteps else [])  # fmt: skip
+    return train(parse_args(argv + list(job.train_args)))
 
 
-def heldout_score(args: argparse.Namespace, run: pathlib.Path, env_kwargs: dict[str, Any]) -> Score:
-    """The best model of ``run`` on ``args.episodes`` held-out episodes: the training's final
+def heldout_score(job: SeedJob, run: pathlib.Path) -> Score:
+    """The best model of ``run`` on ``job.episodes`` held-out episodes: the training's final
     evaluation (``scores.json``) if it has that many, else a new one kept in ``heldout_{n}.json``
     (the same episodes, seeds 10,000 on: a longer evaluation extends the shorter one)."""
     stored = Score(**json.loads((run / "scores.json").read_text())[0])
-    if stored.episodes == args.episodes:
+    if stored.episodes == job.episodes:
         return stored
-    path = run / f"heldout_{args.episodes}.json"
+    path = run / f"heldout_{job.episodes}.json"
     if not path.exists():
-        score = evaluate(run, env_kwargs, args.episodes, algo=args.algo, progress=True)
+        score = evaluate(run, job.env_kwargs, job.episodes, algo=job.algo, progress=True)
         score = Score(**{**asdict(score), "policy": stored.policy})
         path.write_text(json.dumps(asdict(score), indent=2))
     return Score(**json.loads(path.read_text()))
 
 
+def train_seeds(args: argparse.Namespace, env_kwargs: dict[str, Any]) -> list[SeedResult]:
+    """Every seed of ``args.seeds`` through :func:`run_seed`, one after the other or as Ray tasks
+    (``args.cluster``), in seed order. A seed whose task was lost with its worker is reported and
+    left out; a RuntimeError if every seed was lost."""
+    from ballenv.cluster import collect, run_tasks
+
+    from .train import ROOT, compile_once
+
+    jobs = [
+        SeedJob(args.algo, args.action_mode, seed, args.timesteps, args.episodes, args.out, env_kwargs,
+                tuple(args.train_args))
+        for seed in args.seeds
+    ]  # fmt: skip
+    outcomes = run_tasks(
+        run_seed, jobs, args.cluster, desc="training seeds", warm=functools.partial(compile_once, env_kwargs),
+        paths=[str(ROOT)], progress=args.cluster is not None,
+    )  # fmt: skip
+    results, lost = collect(outcomes, len(jobs))
+    for task in lost:
+        print(f"seed {jobs[task.index].seed} left out: its task was lost ({task.reason})")
+    kept = [r for r in results if r is not None]
+    if not kept:
+        raise RuntimeError(f"every training seed of {args.seeds} was lost; nothing to compare")
+    return kept
+
+
 def plot(
-    path: pathlib.Path, runs: Sequence[pathlib.Path], baselines: Sequence[dict[str, Any]], title: str
+    path: pathlib.Path, runs: Sequence[SeedResult], baselines: Sequence[dict[str, Any]], title: str
 ) -> None:
     """Mean periodic-evaluation return over seeds (band: lowest to highest seed) against env steps,
     the baselines' held-out returns as lines."""
@@ -129,10 +204,9 @@ def plot(
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    curves = [np.load(r / "evaluations.npz") for r in runs]
-    steps = curves[0]["timesteps"]
-    n = min(len(c["timesteps"]) for c in curves)
-    returns = np.array([c["results"][:n].mean(axis=1) for c in curves])
+    steps = runs[0].steps
+    n = min(len(r.steps) for r in runs)
+    returns = np.array([r.returns[:n] for r in runs])
     fig, ax = plt.subplots(figsize=(6, 4))
     ax.plot(steps[:n], returns.mean(axis=0), "o-", label=f"trained, mean of {len(runs)} seeds")
     ax.fill_between(steps[:n], returns.min(axis=0), returns.max(axis=0), alpha=0.2)
@@ -157,6 +231,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--episodes", type=int, default=20, help="held-out episodes per policy and run")
     p.add_argument("--out", type=pathlib.Path, default=pathlib.Path("runs/study"))
     p.add_argument("--env-kwargs", type=parse_env_kwargs, default={}, help="JSON object of env keywords")
+    add_cluster_argument(p, "the training seeds (each trained and scored in one task)")
     return p
 
 
@@ -165,9 +240,9 @@ def main(argv: Sequence[str] | None = None) -> None:
     args.train_args = rest  # goes to agents.train
     if args.env_kwargs:
         args.train_args += ["--env-kwargs", json.dumps(args.env_kwargs)]
-    runs = [train_seed(args, seed) for seed in args.seeds]
     mode = task_env_kwargs(args.algo, args.action_mode, args.env_kwargs)  # the YAML's env_kwargs too
-    trained = [heldout_score(args, run, mode) for run in runs]
+    runs = train_seeds(args, mode)
+    trained = [r.score for r in runs]
     baselines = [
         summarise(name, [evaluate(name, mode, args.episodes, progress=True)])
         for name in ("heuristic", "random")

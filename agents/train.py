@@ -32,7 +32,6 @@ import sys
 import time
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import asdict
-from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -46,6 +45,7 @@ if TYPE_CHECKING:
     from .evaluate import Score
 
 HYPERPARAMS = pathlib.Path(__file__).parent / "hyperparams"
+ROOT = pathlib.Path(__file__).resolve().parent.parent  # holds agents/: on a Ray worker's PYTHONPATH
 RUN_KEYS = ("n_timesteps", "n_envs", "policy", "normalize", "env_kwargs", "env_wrapper")
 OnEvaluation = Callable[[int, float], bool]  # (env steps, mean return) -> go on training
 
@@ -77,6 +77,27 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
     p.add_argument("--log-dir", default="runs", help="parent folder of the run folder")
     p.add_argument("--no-baselines", action="store_true", help="score only the trained agent at the end")
     return p.parse_args(argv)
+
+
+def add_cluster_argument(p: argparse.ArgumentParser, runs: str) -> None:
+    """The ``--cluster`` option of a command whose ``runs`` (e.g. "the training seeds") can be Ray
+    tasks (``ballenv.cluster.run_tasks``)."""
+    p.add_argument(
+        "--cluster", type=check_cluster_name, default=None,
+        help=f"run {runs} as Ray tasks: 'local' (a Ray cluster on this machine, one task per core), "
+        "'auto' (the running cluster) or its address (host:6379, ray://host:10001); default: one "
+        "after the other in this process",
+    )  # fmt: skip
+
+
+def check_cluster_name(text: str) -> str:
+    """``--cluster``'s value, checked by ``ballenv.cluster.check_cluster`` (argparse reports its error)."""
+    from ballenv.cluster import check_cluster
+
+    try:
+        return str(check_cluster(text))
+    except ValueError as err:
+        raise argparse.ArgumentTypeError(str(err)) from None
 
 
 def env_id(mode: str) -> str:
@@ -141,13 +162,12 @@ def make_envs(
     subproc: bool = False,
     wrapper: str | None = None,
 ) -> VecEnv:
-    import gymnasium as gym
     from stable_baselines3.common.env_util import make_vec_env
     from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecNormalize
 
     from .wrappers import wrapper_class
 
-    compile_once(gym, env_kwargs)
+    compile_once(env_kwargs)
     envs = make_vec_env(
         env_id(env_kwargs["action_mode"]), n_envs=n_envs, seed=seed, env_kwargs=env_kwargs,
         wrapper_class=wrapper_class(wrapper),
@@ -159,10 +179,12 @@ def make_envs(
     return envs
 
 
-def compile_once(gym: ModuleType, env_kwargs: dict[str, Any]) -> None:
+def compile_once(env_kwargs: dict[str, Any]) -> None:
     """Reset and step one env here, before any worker process starts: numba compiles the simulator
     once (or loads it from its cache) and the workers load it from the cache instead of each
-    compiling it."""
+    compiling it. Also the warm-up of a cluster's nodes (``ballenv.cluster.run_tasks``'s ``warm``)."""
+    import gymnasium as gym
+
     env = gym.make(env_id(env_kwargs["action_mode"]), **env_kwargs)
     env.reset(seed=0)
     env.step(env.action_space.sample())

@@ -2,6 +2,7 @@
 
     python -m agents.tune heuristic --action-mode pressure --trials 60
     python -m agents.tune ppo --action-mode paddle --trials 12 --timesteps 100000 [train.py options]
+    python -m agents.tune ppo --trials 12 --cluster local --parallel 2     # trials as Ray tasks
 
 Both search with Optuna's TPE sampler (seeded: the same command gives the same trials) on training
 seeds; the held-out seeds of ``agents.evaluate`` (10,000 on) stay unseen.
@@ -16,11 +17,22 @@ seeds; the held-out seeds of ``agents.evaluate`` (10,000 on) stay unseen.
   ``agents.train``, its periodic evaluations (mean return over 5 episodes) feed Optuna's median
   pruner, and the objective is the last one. The trials' table and the best entry (RL Zoo format)
   are written to ``{out}/ppo_{mode}.md`` and ``{out}/ppo_{mode}.yml``.
+
+``--cluster local|auto|ADDRESS`` runs the trials as Ray tasks (``ballenv.cluster.run_tasks``)
+through Optuna's ask-and-tell interface: ``--parallel`` trials (default: the cluster's CPUs) are
+asked, run at once and told in trial order, then the next batch. A task cannot hear the pruner
+while it trains, so no trial is pruned there (its evaluations are recorded after it). The sampler
+is the same, but it sees fewer finished trials: with the same ``--seed`` the trials equal the serial
+search's through TPE's random start-up trials (10 for ``heuristic``, 4 for ``ppo``); from the first
+later trial asked while another is still running, they differ (TPE counts the running trials among
+the worse ones, Optuna's "constant liar"), and the serial search may prune where this one does not.
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
+import functools
 import json
 import pathlib
 from collections.abc import Callable, Sequence
@@ -34,7 +46,7 @@ if TYPE_CHECKING:
 
 from .baselines import HEURISTIC_PARAMS, HeuristicPolicy, heuristic_table
 from .evaluate import evaluate
-from .train import task_env_kwargs
+from .train import ROOT, OnEvaluation, add_cluster_argument, compile_once, task_env_kwargs
 
 # name -> (low, high, log scale) of each controller parameter
 HEURISTIC_SPACE = {
@@ -50,6 +62,40 @@ HEURISTIC_SPACE = {
 }
 
 
+@dataclasses.dataclass(frozen=True)
+class TrialResult:
+    """One trial's outcome as plain data (what a Ray task returns): the objective ``value``, the
+    user attributes to record and the intermediate values ``(env steps, mean return)`` it reported."""
+
+    value: float
+    attrs: dict[str, Any]
+    reports: tuple[tuple[int, float], ...] = ()
+
+
+@dataclasses.dataclass(frozen=True)
+class HeuristicTrial:
+    """A heuristic trial as plain data: the controller's ``params`` scored on ``episodes`` episodes
+    (seeds 0, 1, ...) of the env of ``env_kwargs``."""
+
+    params: dict[str, float]
+    episodes: int
+    env_kwargs: dict[str, Any]
+
+
+def sample_heuristic(trial: optuna.Trial, mode: str) -> dict[str, float]:
+    """The controller parameters of one trial in action mode ``mode`` (:data:`HEURISTIC_SPACE`)."""
+    return {
+        name: trial.suggest_float(name, low, high, log=log)
+        for name, (low, high, log) in HEURISTIC_SPACE[mode].items()
+    }
+
+
+def score_heuristic(job: HeuristicTrial) -> TrialResult:
+    """The mean apex error of the controller with ``job.params`` (and its success rate)."""
+    score = evaluate(lambda env: HeuristicPolicy(env, job.params), job.env_kwargs, job.episodes, seed=0)
+    return TrialResult(score.apex_error, {"success_rate": score.success_rate})
+
+
 def heuristic_objective(
     mode: str, episodes: int, env_kwargs: dict[str, Any]
 ) -> Callable[[optuna.Trial], float]:
@@ -57,17 +103,17 @@ def heuristic_objective(
     ``env_kwargs``."""
 
     def objective(trial: optuna.Trial) -> float:
-        params = {
-            name: trial.suggest_float(name, low, high, log=log)
-            for name, (low, high, log) in HEURISTIC_SPACE[mode].items()
-        }
-        score = evaluate(
-            lambda env: HeuristicPolicy(env, params), env_kwargs, episodes, seed=0
-        )  # fmt: skip
-        trial.set_user_attr("success_rate", score.success_rate)
-        return score.apex_error
+        result = score_heuristic(HeuristicTrial(sample_heuristic(trial, mode), episodes, env_kwargs))
+        record(trial, result)
+        return result.value
 
     return objective
+
+
+def record(trial: optuna.Trial, result: TrialResult) -> None:
+    """Keep ``result``'s user attributes in ``trial``."""
+    for key, value in result.attrs.items():
+        trial.set_user_attr(key, value)
 
 
 def tune_heuristic(args: argparse.Namespace) -> optuna.Study:
@@ -75,7 +121,13 @@ def tune_heuristic(args: argparse.Namespace) -> optuna.Study:
 
     study = optuna.create_study(direction="minimize", sampler=optuna.samplers.TPESampler(seed=args.seed))
     env_kwargs = task_env_kwargs("ppo", args.action_mode)  # the task the agents train on
-    study.optimize(heuristic_objective(args.action_mode, args.episodes, env_kwargs), n_trials=args.trials)
+    if args.cluster is None:
+        study.optimize(heuristic_objective(args.action_mode, args.episodes, env_kwargs), n_trials=args.trials)
+    else:
+        optimize_on_cluster(
+            study, lambda t: HeuristicTrial(sample_heuristic(t, args.action_mode), args.episodes, env_kwargs),
+            score_heuristic, args, warm=functools.partial(compile_once, env_kwargs),
+        )  # fmt: skip
     best = {k: round(float(v), 4) for k, v in study.best_params.items()}
     print(f"best apex error {study.best_value:.4f} over {args.episodes} training episodes: {best}")
     if not args.dry_run:
@@ -113,26 +165,39 @@ def sample_ppo(trial: optuna.Trial | optuna.trial.FixedTrial) -> dict[str, Any]:
     }
 
 
+def ppo_argv(args: argparse.Namespace, hp: dict[str, Any], number: int) -> tuple[str, ...]:
+    """``agents.train``'s command line of trial ``number`` with hyperparameters ``hp``."""
+    return (
+        "--algo", "ppo", "--action-mode", args.action_mode, "--vec-env", "subproc",
+        "--total-timesteps", str(args.timesteps), "--eval-freq", str(args.timesteps // 5),
+        "--seed", str(args.seed + number), "--log-dir", str(args.out / f"ppo_{args.action_mode}"),
+        "--no-baselines", "--final-episodes", "0", "--hyperparams", json.dumps(hp), *args.train_args,
+    )  # fmt: skip
+
+
+def train_ppo_trial(argv: Sequence[str], on_evaluation: OnEvaluation | None = None) -> TrialResult:
+    """Train one PPO trial with ``agents.train``'s command line ``argv``: its last periodic
+    evaluation (mean return), its run folder and every evaluation; ``on_evaluation``: as
+    ``agents.train.train``'s (it prunes the trial)."""
+    from .train import parse_args, train
+
+    run = train(parse_args(list(argv)), on_evaluation=on_evaluation)
+    log = np.load(run / "evaluations.npz")
+    returns = [float(r) for r in log["results"].mean(axis=1)]
+    reports = tuple(zip((int(t) for t in log["timesteps"]), returns, strict=True))
+    return TrialResult(returns[-1], {"run": str(run)}, reports)
+
+
 def ppo_objective(args: argparse.Namespace) -> Callable[[optuna.Trial], float]:
     """Optuna objective: train one PPO trial, pruned on its periodic evaluations."""
     import optuna
 
-    from .train import parse_args, train
-
     def objective(trial: optuna.Trial) -> float:
-        hp = sample_ppo(trial)
-        argv = [
-            "--algo", "ppo", "--action-mode", args.action_mode, "--vec-env", "subproc",
-            "--total-timesteps", str(args.timesteps), "--eval-freq", str(args.timesteps // 5),
-            "--seed", str(args.seed + trial.number), "--log-dir", str(args.out / f"ppo_{args.action_mode}"),
-            "--no-baselines", "--final-episodes", "0", "--hyperparams", json.dumps(hp),
-        ] + args.train_args  # fmt: skip
-        run = train(parse_args(argv), on_evaluation=_reporter(trial))
-        returns = np.load(run / "evaluations.npz")["results"].mean(axis=1)
-        trial.set_user_attr("run", str(run))
+        result = train_ppo_trial(ppo_argv(args, sample_ppo(trial), trial.number), _reporter(trial))
+        record(trial, result)
         if trial.should_prune():
             raise optuna.TrialPruned()
-        return float(returns[-1])
+        return result.value
 
     return objective
 
@@ -156,7 +221,13 @@ def tune_ppo(args: argparse.Namespace) -> optuna.Study:
         pruner=optuna.pruners.MedianPruner(n_startup_trials=3, n_warmup_steps=args.timesteps // 3),
     )  # fmt: skip
     study.enqueue_trial(_current_ppo(args.action_mode))  # the present file's values first
-    study.optimize(ppo_objective(args), n_trials=args.trials)
+    if args.cluster is None:
+        study.optimize(ppo_objective(args), n_trials=args.trials)
+    else:
+        warm = functools.partial(compile_once, task_env_kwargs("ppo", args.action_mode))
+        optimize_on_cluster(
+            study, lambda t: ppo_argv(args, sample_ppo(t), t.number), train_ppo_trial, args, warm
+        )
     lines = ["| trial | state | last evaluation return | hyperparameters |", "|---:|---|---:|---|"]
     for t in study.trials:
         value = "" if t.value is None else f"{t.value:.1f}"
@@ -168,6 +239,55 @@ def tune_ppo(args: argparse.Namespace) -> optuna.Study:
     print("\n".join(lines))
     print(f"best return {study.best_value:.1f}; wrote {name}.md and {name}.yml")
     return study
+
+
+def optimize_on_cluster(
+    study: optuna.Study,
+    make_job: Callable[[optuna.Trial], Any],
+    task: Callable[[Any], TrialResult],
+    args: argparse.Namespace,
+    warm: Callable[[], Any] | None = None,
+) -> None:
+    """``study.optimize`` with its trials as Ray tasks on ``args.cluster`` (Optuna's ask-and-tell
+    interface): ask ``args.parallel`` trials (default: one per CPU of the cluster), run
+    ``task(make_job(trial))`` for each, tell their results in trial order; again until
+    ``args.trials`` have run. No pruning: a task cannot hear the pruner while it runs (its
+    intermediate values are recorded after it). A trial whose task was lost with its worker fails.
+    ``warm``: ``ballenv.cluster.run_tasks``'s, run before the first batch."""
+    from ballenv.cluster import collect, connect, run_tasks
+    from ballenv.extras import optional_module
+
+    started = connect(args.cluster, paths=[str(ROOT)])
+    ray = optional_module("ray", "tuning on a Ray cluster", "ray", "ray")
+    try:
+        size = args.parallel or max(int(ray.cluster_resources().get("CPU", 1)), 1)
+        for first in range(0, args.trials, size):
+            asked = [study.ask() for _ in range(min(size, args.trials - first))]
+            outcomes = run_tasks(
+                task, [make_job(t) for t in asked], args.cluster, desc=f"trials from {first}",
+                warm=warm if first == 0 else None, paths=[str(ROOT)],
+            )  # fmt: skip
+            results, _ = collect(outcomes, len(asked))
+            for trial, result in zip(asked, results, strict=True):
+                tell(study, trial, result)
+    finally:
+        if started:
+            ray.shutdown()
+
+
+def tell(study: optuna.Study, trial: optuna.Trial, result: TrialResult | None) -> None:
+    """Tell ``study`` the ``result`` of ``trial`` (its user attributes and intermediate values
+    recorded first); ``None`` (its task was lost) fails the trial."""
+    import optuna
+
+    if result is None:
+        print(f"trial {trial.number} failed: its task was lost with its worker")
+        study.tell(trial, state=optuna.trial.TrialState.FAIL)
+        return
+    record(trial, result)
+    for step, value in result.reports:
+        trial.report(value, step)
+    study.tell(trial, result.value)
 
 
 def _current_ppo(mode: str) -> dict[str, Any]:
@@ -195,12 +315,38 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=0, help="sampler seed (ppo: trial k trains with seed + k)")
     p.add_argument("--out", type=pathlib.Path, default=pathlib.Path("runs/tune"), help="ppo: output folder")
     p.add_argument("--dry-run", action="store_true", help="heuristic: print the best, do not write it")
+    add_cluster_argument(p, "the trials (asked and told in batches, not pruned)")
+    p.add_argument(
+        "--parallel", type=positive_int, default=None,
+        help="with --cluster: trials asked and run at once (default: the cluster's CPUs)",
+    )  # fmt: skip
     return p
 
 
-def main(argv: Sequence[str] | None = None) -> None:
-    args, rest = build_parser().parse_known_args(argv)
+def positive_int(text: str) -> int:
+    """An integer >= 1 of the command line (argparse reports its error)."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{text!r} is invalid: must be an integer >= 1")
+    return value
+
+
+def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
+    """The options of ``python -m agents.tune``; the arguments it does not know, for agents.train,
+    in ``train_args``."""
+    parser = build_parser()
+    args, rest = parser.parse_known_args(argv)
+    if args.parallel is not None and args.cluster is None:
+        parser.error(f"--parallel {args.parallel} needs --cluster (without it the trials run one by one)")
     args.train_args = rest  # ppo: goes to agents.train
+    return args
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    args = parse_args(argv)
     (tune_heuristic if args.what == "heuristic" else tune_ppo)(args)
 
 

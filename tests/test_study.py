@@ -1,11 +1,12 @@
-"""agents.study: the interquartile mean, its two-level bootstrap interval, and a tiny study end to end."""
+"""agents.study: the interquartile mean, its two-level bootstrap interval, a tiny study end to end,
+serially and on a local Ray cluster."""
 
 import json
 
 import numpy as np
 import pytest
 
-from agents.study import bootstrap_iqm, iqm, main
+from agents.study import bootstrap_iqm, build_parser, iqm, main, train_seeds
 
 SHORT = {"max_episode_steps": 60}
 
@@ -57,3 +58,50 @@ def test_a_tiny_study_runs_end_to_end(tmp_path, capsys):
     assert longer["episode_apex_errors"][:2] == stored["episode_apex_errors"]  # the same first episodes
     rows = json.loads((tmp_path / "ppo_pressure.json").read_text())
     assert rows[0]["episodes"] == 6 and rows[1]["episodes"] == 3
+
+
+def test_seeds_trained_as_ray_tasks_give_the_serial_results(tmp_path, local_ray):
+    """Two seeds with two envs each (one process per env, as the serial run) trained as Ray tasks:
+    the same held-out scores, learning curves and table as one after the other in this process."""
+    argv = [
+        "--seeds", "0", "1", "--episodes", "2", "--env-kwargs", json.dumps(SHORT), "--timesteps", "256",
+        "--n-envs", "2", "--eval-freq", "128", "--eval-episodes", "1",
+        "--hyperparams", json.dumps({"n_steps": 64, "batch_size": 64, "n_epochs": 1}),
+    ]  # fmt: skip
+    main([*argv, "--out", str(tmp_path / "serial")])
+    main([*argv, "--out", str(tmp_path / "ray"), "--cluster", "local"])
+    for seed in (0, 1):
+        serial, ray = (tmp_path / where / f"ppo_pressure_seed{seed}" for where in ("serial", "ray"))
+        scores = [json.loads((run / "scores.json").read_text()) for run in (serial, ray)]
+        assert scores[1] == scores[0]
+        curves = np.load(serial / "evaluations.npz"), np.load(ray / "evaluations.npz")
+        assert curves[0]["timesteps"].size == 2
+        np.testing.assert_array_equal(curves[1]["results"], curves[0]["results"])
+    rows = [json.loads((tmp_path / where / "ppo_pressure.json").read_text()) for where in ("serial", "ray")]
+    assert rows[1] == rows[0] and rows[1][0]["runs"] == 2
+
+
+def test_a_seed_lost_with_its_worker_is_left_out_and_named(monkeypatch, capsys):
+    """Ray gave up on seed 1's task (its worker died on every try): the study goes on with seed 0's
+    result and says which seed is missing; with every seed lost there is nothing to compare."""
+    import ballenv.cluster
+    from ballenv.cluster import TaskLost
+
+    def outcomes(fn, jobs, cluster, **options):
+        assert cluster == "auto" and [job.seed for job in jobs] == [0, 1]
+        yield 1, TaskLost(1, "WorkerCrashedError: the worker died")
+        yield 0, "seed 0's result"
+
+    monkeypatch.setattr(ballenv.cluster, "run_tasks", outcomes)
+    args, rest = build_parser().parse_known_args(["--seeds", "0", "1", "--cluster", "auto"])
+    args.train_args = rest
+    assert train_seeds(args, {"action_mode": "pressure"}) == ["seed 0's result"]
+    assert (
+        "seed 1 left out: its task was lost (WorkerCrashedError: the worker died)" in capsys.readouterr().out
+    )
+    monkeypatch.setattr(
+        ballenv.cluster, "run_tasks", lambda fn, jobs, cluster, **o: iter([(0, TaskLost(0, "x"))])
+    )
+    args.seeds = [0]
+    with pytest.raises(RuntimeError, match=r"every training seed of \[0\] was lost"):
+        train_seeds(args, {"action_mode": "pressure"})
