@@ -5,7 +5,7 @@ episodes, interquartile mean (IQM) with bootstrap confidence intervals, learning
     python -m agents.study --algo ppo --action-mode paddle --timesteps 400000 --out runs/study
     python -m agents.study --seeds 0 --episodes 2 --env-kwargs '{"max_episode_steps": 60}' \
         --timesteps 512 --n-envs 1 --hyperparams '{"n_steps": 64}'     # train.py options pass through
-    python -m agents.study --seeds 0 1 2 3 --cluster local      # the seeds as Ray tasks (or auto, host:6379)
+    python -m agents.study --seeds 0 1 2 3 --ray local      # the seeds as Ray tasks (or auto, host:6379)
 
 Each seed trains with ``agents.train`` into ``{out}/{algo}_{mode}_seed{k}`` (a folder that already
 holds ``scores.json`` is reused, so an interrupted study resumes); its best model is scored on the
@@ -14,7 +14,7 @@ study with more ``--episodes`` scores the trained models again, without training
 ``{out}/{algo}_{mode}.md`` (the table) and ``{out}/{algo}_{mode}.png`` (learning curves, the
 baselines as lines).
 
-With ``--cluster``, each seed is one Ray task (``ballenv.cluster.run_tasks``) that trains it and
+With ``--ray``, each seed is one Ray task (``ballenv.cluster.run_tasks``) that trains it and
 scores it on the held-out episodes; the baselines are scored here. A task runs its seed as the
 serial study does (``--vec-env subproc``: one process per env, torch on one thread), so the same
 seeds give the same scores, curves and table. Its run folder is written under ``--out`` on the

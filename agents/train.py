@@ -80,10 +80,10 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
 
 
 def add_cluster_argument(p: argparse.ArgumentParser, runs: str) -> None:
-    """The ``--cluster`` option of a command whose ``runs`` (e.g. "the training seeds") can be Ray
+    """The ``--ray`` option of a command whose ``runs`` (e.g. "the training seeds") can be Ray
     tasks (``ballenv.cluster.run_tasks``)."""
     p.add_argument(
-        "--cluster", type=check_cluster_name, default=None,
+        "--ray", dest="cluster", metavar="ADDRESS", type=check_cluster_name, default=None,
         help=f"run {runs} as Ray tasks: 'local' (a Ray cluster on this machine, one task per core), "
         "'auto' (the running cluster) or its address (host:6379, ray://host:10001); default: one "
         "after the other in this process",
@@ -91,7 +91,7 @@ def add_cluster_argument(p: argparse.ArgumentParser, runs: str) -> None:
 
 
 def check_cluster_name(text: str) -> str:
-    """``--cluster``'s value, checked by ``ballenv.cluster.check_cluster`` (argparse reports its error)."""
+    """``--ray``'s value, checked by ``ballenv.cluster.check_cluster`` (argparse reports its error)."""
     from ballenv.cluster import check_cluster
 
     try:

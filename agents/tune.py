@@ -2,7 +2,7 @@
 
     python -m agents.tune heuristic --action-mode pressure --trials 60
     python -m agents.tune ppo --action-mode paddle --trials 12 --timesteps 100000 [train.py options]
-    python -m agents.tune ppo --trials 12 --cluster local --parallel 2     # trials as Ray tasks
+    python -m agents.tune ppo --trials 12 --ray local --parallel 2     # trials as Ray tasks
 
 Both search with Optuna's TPE sampler (seeded: the same command gives the same trials) on training
 seeds; the held-out seeds of ``agents.evaluate`` (10,000 on) stay unseen.
@@ -18,7 +18,7 @@ seeds; the held-out seeds of ``agents.evaluate`` (10,000 on) stay unseen.
   pruner, and the objective is the last one. The trials' table and the best entry (RL Zoo format)
   are written to ``{out}/ppo_{mode}.md`` and ``{out}/ppo_{mode}.yml``.
 
-``--cluster local|auto|ADDRESS`` runs the trials as Ray tasks (``ballenv.cluster.run_tasks``)
+``--ray local|auto|ADDRESS`` runs the trials as Ray tasks (``ballenv.cluster.run_tasks``)
 through Optuna's ask-and-tell interface: ``--parallel`` trials (default: the cluster's CPUs) are
 asked, run at once and told in trial order, then the next batch. A task cannot hear the pruner
 while it trains, so no trial is pruned there (its evaluations are recorded after it). The sampler
@@ -318,7 +318,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_cluster_argument(p, "the trials (asked and told in batches, not pruned)")
     p.add_argument(
         "--parallel", type=positive_int, default=None,
-        help="with --cluster: trials asked and run at once (default: the cluster's CPUs)",
+        help="with --ray: trials asked and run at once (default: the cluster's CPUs)",
     )  # fmt: skip
     return p
 
@@ -340,7 +340,7 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
     parser = build_parser()
     args, rest = parser.parse_known_args(argv)
     if args.parallel is not None and args.cluster is None:
-        parser.error(f"--parallel {args.parallel} needs --cluster (without it the trials run one by one)")
+        parser.error(f"--parallel {args.parallel} needs --ray (without it the trials run one by one)")
     args.train_args = rest  # ppo: goes to agents.train
     return args
 

@@ -70,18 +70,24 @@ def _ray():
     return optional_module("ray", "running a sweep on a Ray cluster", "ray", "ray")
 
 
-def connect(cluster: str, num_cpus: int | None = None, paths: Sequence[str] = ()) -> bool:
+def connect(
+    cluster: str,
+    num_cpus: int | None = None,
+    paths: Sequence[str] = (),
+    env_vars: dict[str, str] | None = None,
+) -> bool:
     """Connect this process to ``cluster`` (start one for ``"local"``) unless Ray is already
     initialised; ``paths`` are added to the workers' ``PYTHONPATH`` (the folders the task functions
-    are imported from, e.g. a checkout's root for ``benchmarks`` and ``tests``). Returns whether this
-    call started the connection (the caller then shuts it down)."""
+    are imported from, e.g. a checkout's root for ``benchmarks`` and ``tests``), ``env_vars`` set in
+    their environment (e.g. ``NUMBA_CACHE_DIR``). Returns whether this call started the connection
+    (the caller then shuts it down)."""
     ray = _ray()
     if ray.is_initialized():
         return False
     python_path = [str(p) for p in paths] + [
         p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p
     ]
-    env_vars = {"OPENBLAS_NUM_THREADS": os.environ.get("OPENBLAS_NUM_THREADS", "1")}
+    env_vars = {"OPENBLAS_NUM_THREADS": os.environ.get("OPENBLAS_NUM_THREADS", "1"), **(env_vars or {})}
     if python_path:
         env_vars["PYTHONPATH"] = os.pathsep.join(dict.fromkeys(python_path))
     local = cluster == LOCAL

@@ -11,12 +11,14 @@ tallies of the three runs must be equal. The overhead per task: 400 tasks that r
 each cluster (wall time x workers / 400). The projection for the full soak (1,800 scenes) on ``W``
 workers: its work is taken as 1,800 times the mean time per scene measured here, and the time is at
 least the longest single scene (a task runs on one core):
-``max(work / W, longest) + overhead * 1800 / W``.
+``max(work / W, longest) + overhead * 1800 / W``. Last, the first ``--cold-scenes`` scenes on two
+workers compiling into an empty numba cache, with the warm-up task and without it.
 """
 
 import argparse
 import pathlib
 import sys
+import tempfile
 import time
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
@@ -78,6 +80,27 @@ def one_way(tasks, workers):
     return out
 
 
+def cold_start(tasks, warm):
+    """Wall time (s) of ``tasks`` on a fresh 2-worker local cluster whose workers compile into an
+    empty numba cache, with the warm-up first (``warm``) or without (each worker compiles what its
+    first scenes call, both at once), and the workers' CPU time (s) of the compiling."""
+    with tempfile.TemporaryDirectory() as cache:
+        connect(
+            "local",
+            num_cpus=2,
+            paths=[str(ROOT), str(ROOT / "benchmarks")],
+            env_vars={"NUMBA_CACHE_DIR": cache},
+        )
+        start = time.perf_counter()
+        warming = (lambda: warm_simulator(audit)) if warm else None
+        results, lost = collect(
+            run_tasks(timed_scene, tasks, "local", progress=False, warm=warming), len(tasks)
+        )
+        wall = time.perf_counter() - start
+        ray.shutdown()
+    return wall, sum(r[1] for r in results if r is not None)
+
+
 def projection(times, overhead, workers):
     """Projected wall time (s) of the full soak on ``workers`` cores and what bounds it."""
     work = SOAK_SCENES * sum(times) / len(times)
@@ -88,7 +111,7 @@ def projection(times, overhead, workers):
     ) + overhead * SOAK_SCENES / workers, "longest scene" if longest > spread else "work"
 
 
-def report(args, runs, soak):
+def report(args, runs, soak, cold):
     serial, one, two = runs
     tallies = [soak.tally_scenes(soak.draw_scenes(args.scenes, 0), r["outcomes"])[:3] for r in runs]
     same = tallies[0] == tallies[1] == tallies[2]
@@ -123,19 +146,34 @@ def report(args, runs, soak):
     for workers in (1, 2, CLUSTER_CORES):
         wall, bound = projection(times, two["overhead"], workers)
         lines.append(f"| {workers} | {wall / 60:.1f} min | {bound} |")
+    lines += [
+        "",
+        f"On an empty numba cache (`NUMBA_CACHE_DIR` a new folder; the first {args.cold_scenes} scenes, "
+        "2 workers, cluster start not counted):",
+        "",
+        "| | sweep wall (s) | the scenes' own time in the workers (s) |",
+        "|---|---:|---:|",
+        *[
+            f"| {'warm-up once on the node first' if warm else 'no warm-up: each worker compiles'} "
+            f"| {wall:.1f} | {work:.1f} |"
+            for warm, (wall, work) in cold.items()
+        ],
+    ]
     return "\n".join(lines) + "\n"
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scenes", type=int, default=200)
+    parser.add_argument("--cold-scenes", type=int, default=20, help="scenes of the empty-cache runs")
     args = parser.parse_args()
     sys.path.insert(0, str(ROOT / "benchmarks"))
     import soak
 
     tasks = soak.draw_scenes(args.scenes, 0)
     runs = [one_way(tasks, workers) for workers in (0, 1, 2)]
-    text = report(args, runs, soak)
+    cold = {warm: cold_start(tasks[: args.cold_scenes], warm) for warm in (True, False)}
+    text = report(args, runs, soak, cold)
     print(text)
     (RESULTS / "cluster_scaling.md").write_text(text)
 

@@ -10,7 +10,7 @@ import time
 import numpy as np
 import pytest
 
-from ballenv.cluster import TaskLost, check_cluster, collect, connect, run_tasks
+from ballenv.cluster import TaskLost, check_cluster, collect, run_tasks
 from ballenv.scenes import run as run_scene
 from tests.benchmark_modules import BENCHMARKS, load_benchmark
 
@@ -42,12 +42,9 @@ def test_bad_settings_are_named():
 
 
 @pytest.fixture(scope="module")
-def cluster():
-    """A local Ray cluster of two workers that import from the checkout and its benchmarks."""
-    started = connect("local", num_cpus=2, paths=[str(ROOT), str(BENCHMARKS)])
-    yield "local"
-    if started:
-        ray.shutdown()
+def cluster(local_ray):
+    """The name ``run_tasks`` takes for the module's local Ray cluster (``conftest.local_ray``)."""
+    return "local"
 
 
 def test_the_soak_on_ray_tallies_as_the_serial_run(cluster):
@@ -122,3 +119,13 @@ def test_nothing_but_a_sweep_on_a_cluster_imports_ray():
         "assert 'ray' not in sys.modules, 'ray imported'"
     )
     subprocess.run([sys.executable, "-c", code], check=True, cwd=ROOT)
+
+
+def test_the_aws_cluster_configuration_passes_ray_s_schema():
+    yaml = pytest.importorskip("yaml")
+    from ray.autoscaler._private.util import prepare_config, validate_config
+
+    config = yaml.safe_load((ROOT / "docs" / "ray-cluster-aws.yaml").read_text())
+    validate_config(prepare_config(config))  # raises on a field Ray's cluster launcher does not know
+    setup = " ".join(config["setup_commands"])
+    assert "constraints.txt" in setup and "[ray" in setup  # the pinned install, the ray extra

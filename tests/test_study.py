@@ -69,7 +69,7 @@ def test_seeds_trained_as_ray_tasks_give_the_serial_results(tmp_path, local_ray)
         "--hyperparams", json.dumps({"n_steps": 64, "batch_size": 64, "n_epochs": 1}),
     ]  # fmt: skip
     main([*argv, "--out", str(tmp_path / "serial")])
-    main([*argv, "--out", str(tmp_path / "ray"), "--cluster", "local"])
+    main([*argv, "--out", str(tmp_path / "ray"), "--ray", "local"])
     for seed in (0, 1):
         serial, ray = (tmp_path / where / f"ppo_pressure_seed{seed}" for where in ("serial", "ray"))
         scores = [json.loads((run / "scores.json").read_text()) for run in (serial, ray)]
@@ -93,7 +93,7 @@ def test_a_seed_lost_with_its_worker_is_left_out_and_named(monkeypatch, capsys):
         yield 0, "seed 0's result"
 
     monkeypatch.setattr(ballenv.cluster, "run_tasks", outcomes)
-    args, rest = build_parser().parse_known_args(["--seeds", "0", "1", "--cluster", "auto"])
+    args, rest = build_parser().parse_known_args(["--seeds", "0", "1", "--ray", "auto"])
     args.train_args = rest
     assert train_seeds(args, {"action_mode": "pressure"}) == ["seed 0's result"]
     assert (

@@ -54,7 +54,7 @@ def test_ppo_trials_as_ray_tasks_equal_the_serial_search(tmp_path, local_ray):
         "--eval-episodes", "1",
     ]  # fmt: skip
     serial = tune_ppo(parse_args([*argv, "--out", str(tmp_path / "serial")]))
-    on_ray = ["--out", str(tmp_path / "ray"), "--cluster", "local", "--parallel", "2"]
+    on_ray = ["--out", str(tmp_path / "ray"), "--ray", "local", "--parallel", "2"]
     ray = tune_ppo(parse_args([*argv, *on_ray]))
     assert [t.state.name for t in ray.trials] == ["COMPLETE", "COMPLETE"]
     for a, b in zip(serial.trials, ray.trials, strict=True):
@@ -69,7 +69,7 @@ def test_heuristic_trials_as_ray_tasks_follow_the_serial_search_through_its_rand
     (asked after them) are those of the serial search; later ones see fewer finished trials."""
     argv = ["heuristic", "--action-mode", "paddle", "--trials", "12", "--episodes", "1", "--dry-run"]
     serial = tune_heuristic(parse_args(argv))
-    ray = tune_heuristic(parse_args([*argv, "--cluster", "local", "--parallel", "2"]))
+    ray = tune_heuristic(parse_args([*argv, "--ray", "local", "--parallel", "2"]))
     assert len(ray.trials) == 12 and all(t.state.name == "COMPLETE" for t in ray.trials)
     for a, b in zip(serial.trials[:11], ray.trials[:11], strict=True):
         assert (b.params, b.value, b.user_attrs) == (a.params, a.value, a.user_attrs)
@@ -85,7 +85,7 @@ def test_a_lost_task_fails_its_trial_and_parallel_needs_a_cluster(capsys):
     assert "trial 0 failed: its task was lost" in capsys.readouterr().out
     with pytest.raises(SystemExit):
         parse_args(["heuristic", "--parallel", "2"])
-    assert "--parallel 2 needs --cluster" in capsys.readouterr().err
+    assert "--parallel 2 needs --ray" in capsys.readouterr().err
     with pytest.raises(SystemExit):
-        parse_args(["heuristic", "--cluster", "local", "--parallel", "0"])
+        parse_args(["heuristic", "--ray", "local", "--parallel", "0"])
     assert "'0' is invalid: must be an integer >= 1" in capsys.readouterr().err
