@@ -325,7 +325,8 @@ class Scene:
         adaptive: adapt the step to the contact impulse: a step whose impulse exceeds
             ``impulse_tol`` is rejected and shrunk by the ratio, accepted steps grow it cautiously
             (x1.25) back up to ``dt``. False: fixed steps ``dt``. Either way a rejected step (Newton
-            failure, energy gain, intrusion, self-intersection) is retried with half the step.
+            failure, energy gain, intrusion, self-intersection) is retried with half the step;
+            fixed, a halved step doubles back after each accepted step until it is ``dt`` again.
         dt_min: smallest step (s) before simulate() gives up with SimulationError, in (0, dt].
         newton_tol: Newton tolerance on the residual relative to the forces it balances
             (dimensionless), in [1e-14, 1e-2].

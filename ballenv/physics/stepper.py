@@ -468,7 +468,8 @@ def accept(model, solver, ws, state, trial, clock, counters, h, stop, at_grid, r
     """Take the trial step ``state -> trial`` of size ``h`` (s) ending at ``stop`` (s): tallies,
     events, the state, the clock, and the next step size: adaptive, grown by ``min(growth, 1 +
     (ratio - 1) / 2)`` (cautious; ``ratio``: see :func:`advance`) up to
-    ``dt``; fixed, back to ``dt`` once on the grid."""
+    ``dt``; fixed, back to ``dt`` once on the grid, and a step that rejections halved doubled back
+    toward it after each accepted step (the next stop still lands on the grid: :func:`step_end`)."""
     counters[COUNT_STEPS] += 1
     counters[COUNT_ENERGY_PROJECTED] += int(ws.energy_tally[TALLY_PROJECTED])
     clock[CLOCK_ENERGY_REMOVED] += ws.energy_tally[TALLY_REMOVED]
@@ -485,6 +486,8 @@ def accept(model, solver, ws, state, trial, clock, counters, h, stop, at_grid, r
     elif at_grid:
         counters[COUNT_GRID] += 1
         clock[CLOCK_H] = solver.dt
+    else:  # unchanged unless rejections halved it: then twice the step just taken
+        clock[CLOCK_H] = min(max(2.0 * h, clock[CLOCK_H]), solver.dt)
 
 
 @kernel
