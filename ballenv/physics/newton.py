@@ -98,7 +98,8 @@ def residual(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active):
 def correction(model, solver, r, x0, x1, h, ws, active):
     """Solve the Newton system at the iterate ``x1`` and apply the correction to ``ws.dx`` (kept in
     ``ws.delta`` for backtracking). Returns ``(ok, settled)``: ok False on a singular system or a
-    non-finite correction; settled when the correction is at round-off level."""
+    non-finite correction; settled when the correction is at round-off level before the barrier's
+    cut (a correction cut short by an impact ahead is not a converged one)."""
     n = x0.shape[0]
     m = model.node_mass[r]
     c_mass, c_x, c_v, _ = coefficients(solver, h)
@@ -138,7 +139,7 @@ def correction(model, solver, r, x0, x1, h, ws, active):
                 return False, False
             delta[i, d] = c
             dx[i, d] -= c
-            step = max(step, abs(c))
+            step = max(step, abs(res[2 * i + d]))
             size = max(size, abs(x0[i, d]) + abs(dx[i, d]))
     return True, step <= 1e-13 * size
 
