@@ -308,7 +308,7 @@ def joint_correction(model, solver, state, v0, trial, h, ws, rc):
                     return False, False
                 rc.delta[r, i, d] = c
                 rc.dx[r, i, d] -= c
-                step = max(step, abs(c))
+                step = max(step, abs(rc.step[r, 2 * i + d]))  # before the cut, as newton.correction
                 size = max(size, abs(state.x[r, i, d]) + abs(rc.dx[r, i, d]))
     return True, step <= 1e-13 * size
 
