@@ -18,7 +18,7 @@ every attempt died is yielded as :class:`TaskLost` and the sweep goes on, so the
 other task are kept. Each index is yielded exactly once, whether its task was retried or not. An
 exception that ``fn`` raises is re-raised, as in the serial run.
 
-numba compiles the simulator's kernels on first use (about 40 s) and caches them on disk, in the
+numba compiles the simulator's kernels on first use (a minute or more) and caches them on disk, in the
 package's ``__pycache__`` folders (or ``NUMBA_CACHE_DIR``), which every worker of a node shares.
 ``warm`` (a function of no arguments) runs first, once on each node, so that the node's workers load
 the compiled kernels from its cache instead of each compiling them at the same time.

@@ -1,5 +1,5 @@
-"""A sweep on a local Ray cluster: speed-up from one to two workers, the overhead per task, and the
-projected cost of the full soak on a 64-core cluster.
+"""A sweep on a local Ray cluster: speed-up from one to two workers, the overhead per task, and a
+start on an empty numba cache with and without the warm-up.
 
     python benchmarks/cluster_scaling.py [--scenes 200]   # writes benchmarks/results/cluster_scaling.md
 
@@ -8,10 +8,7 @@ through ``ballenv.cluster.run_tasks``: in this process, and on a local Ray clust
 workers (``num_cpus``), each started fresh (its start-up timed apart), with each node's numba cache
 warmed first (``ballenv.cluster.warm_simulator``, timed apart; the cache on disk is warm). The
 tallies of the three runs must be equal. The overhead per task: 400 tasks that return at once, on
-each cluster (wall time x workers / 400). The projection for the full soak (1,800 scenes) on ``W``
-workers: its work is taken as 1,800 times the mean time per scene measured here, and the time is at
-least the longest single scene (a task runs on one core):
-``max(work / W, longest) + overhead * 1800 / W``. Last, the first ``--cold-scenes`` scenes on two
+each cluster (wall time x workers / 400). Last, the first ``--cold-scenes`` scenes on two
 workers compiling into an empty numba cache, with the warm-up task and without it.
 """
 
@@ -29,19 +26,10 @@ import ray  # noqa: E402
 from ballenv.cluster import collect, connect, run_tasks, warm_simulator  # noqa: E402
 from tests.stability.invariants import audit  # noqa: E402
 
+sys.path.insert(0, str(ROOT / "benchmarks"))
+from soak import draw_scenes, run_scene, tally_scenes  # noqa: E402
+
 RESULTS = ROOT / "benchmarks" / "results"
-SOAK_SCENES = 1800
-CLUSTER_CORES = 64
-LONGEST_KNOWN = ("scene 1665 of the full soak (two N = 256 rings, 68 mm walls), measured alone", 270.0)
-
-
-def timed_scene(task):
-    """The soak's run of one scene and its time in the worker (s)."""
-    from soak import run_scene
-
-    start = time.perf_counter()
-    outcome = run_scene(task)
-    return outcome, time.perf_counter() - start
 
 
 def nothing(x):
@@ -69,12 +57,12 @@ def one_way(tasks, workers):
         warm_simulator(audit)
         out["warm"] = time.perf_counter() - start
     start = time.perf_counter()
-    results, lost = collect(run_tasks(timed_scene, tasks, cluster, desc=f"{workers} workers"), len(tasks))
+    results, lost = collect(run_tasks(run_scene, tasks, cluster, desc=f"{workers} workers"), len(tasks))
     out["sweep"] = time.perf_counter() - start
     if lost:
         raise SystemExit(f"scenes lost with their worker: {[t.index for t in lost]}")
-    out["outcomes"] = [r[0] for r in results]
-    out["times"] = [r[1] for r in results]
+    out["outcomes"] = results
+    out["times"] = [r.seconds for r in results]
     if workers:
         ray.shutdown()
     return out
@@ -94,26 +82,16 @@ def cold_start(tasks, warm):
         start = time.perf_counter()
         warming = (lambda: warm_simulator(audit)) if warm else None
         results, lost = collect(
-            run_tasks(timed_scene, tasks, "local", progress=False, warm=warming), len(tasks)
+            run_tasks(run_scene, tasks, "local", progress=False, warm=warming), len(tasks)
         )
         wall = time.perf_counter() - start
         ray.shutdown()
-    return wall, sum(r[1] for r in results if r is not None)
+    return wall, sum(r.seconds for r in results if r is not None)
 
 
-def projection(times, overhead, workers):
-    """Projected wall time (s) of the full soak on ``workers`` cores and what bounds it."""
-    work = SOAK_SCENES * sum(times) / len(times)
-    longest = max(max(times), LONGEST_KNOWN[1])
-    spread = work / workers
-    return max(
-        spread, longest
-    ) + overhead * SOAK_SCENES / workers, "longest scene" if longest > spread else "work"
-
-
-def report(args, runs, soak, cold):
+def report(args, runs, cold):
     serial, one, two = runs
-    tallies = [soak.tally_scenes(soak.draw_scenes(args.scenes, 0), r["outcomes"])[:3] for r in runs]
+    tallies = [tally_scenes(draw_scenes(args.scenes, 0), r["outcomes"])[:3] for r in runs]
     same = tallies[0] == tallies[1] == tallies[2]
     times = serial["times"]
     lines = [
@@ -136,16 +114,9 @@ def report(args, runs, soak, cold):
         f"{max(times):.1f} s (scene {times.index(max(times))}); the two workers' sweep cannot end "
         "before its longest scene.",
         "",
-        f"Projected full soak ({SOAK_SCENES} scenes; work = {SOAK_SCENES} x the mean above = "
-        f"{SOAK_SCENES * sum(times) / len(times) / 60:.1f} min of one core; longest scene at least "
-        f"{LONGEST_KNOWN[1]:.0f} s, {LONGEST_KNOWN[0]}):",
-        "",
-        "| workers | projected wall | bound by |",
-        "|---:|---:|---|",
+        "The full soak's scene times, and the least wall time they allow on 64 cores: "
+        "[soak.md](soak.md) (`benchmarks/soak.py`).",
     ]
-    for workers in (1, 2, CLUSTER_CORES):
-        wall, bound = projection(times, two["overhead"], workers)
-        lines.append(f"| {workers} | {wall / 60:.1f} min | {bound} |")
     lines += [
         "",
         f"On an empty numba cache (`NUMBA_CACHE_DIR` a new folder; the first {args.cold_scenes} scenes, "
@@ -167,13 +138,10 @@ def main():
     parser.add_argument("--scenes", type=int, default=200)
     parser.add_argument("--cold-scenes", type=int, default=20, help="scenes of the empty-cache runs")
     args = parser.parse_args()
-    sys.path.insert(0, str(ROOT / "benchmarks"))
-    import soak
-
-    tasks = soak.draw_scenes(args.scenes, 0)
+    tasks = draw_scenes(args.scenes, 0)
     runs = [one_way(tasks, workers) for workers in (0, 1, 2)]
     cold = {warm: cold_start(tasks[: args.cold_scenes], warm) for warm in (True, False)}
-    text = report(args, runs, soak, cold)
+    text = report(args, runs, cold)
     print(text)
     (RESULTS / "cluster_scaling.md").write_text(text)
 

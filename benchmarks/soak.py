@@ -120,12 +120,14 @@ class SceneOutcome:
     newton_rescues: int = 0
     crash: str = ""
     where: tuple = ()
+    seconds: float = 0.0  # wall time of the run in the process that ran it
 
 
 def run_scene(task):
     """The soak's run of one ``(scene, t_end)`` task: :func:`audit`, or the crash if it raised
     anything but a documented SimulationError (a failure to report, not to stop the sweep on)."""
     scene, t_end = task
+    start = time.perf_counter()
     try:
         result = audit(scene, t_end)
     except Exception as exc:
@@ -137,7 +139,25 @@ def run_scene(task):
         t_reached=float(result.traj.t[-1]),
         energy_projected=stats.energy_projected,
         newton_rescues=stats.newton_rescues,
+        seconds=time.perf_counter() - start,
     )
+
+
+def scene_times(outcomes, cores=(1, 2, 64)):
+    """Lines of the report on the scenes' run times: their sum, the longest, and the least wall time
+    the scenes can take on each number of ``cores`` (one scene runs on one core):
+    ``max(sum / cores, longest)``."""
+    times = [o.seconds for o in outcomes if o is not None]
+    longest = sorted(range(len(times)), key=lambda i: -times[i])[:5]
+    total = sum(times)
+    least = ", ".join(f"{c} cores {max(total / c, times[longest[0]]) / 60:.1f} min" for c in cores)
+    return [
+        f"Run time of the scenes (each in the process that ran it): {total / 60:.1f} min in all, median "
+        f"{1e3 * float(np.median(times)):.0f} ms, longest "
+        + ", ".join(f"{times[i]:.1f} s (scene {i})" for i in longest)
+        + f". Least wall time of the scenes on a cluster, from these times: {least}.",
+        "",
+    ]
 
 
 def draw_scenes(count, seed):
@@ -156,7 +176,7 @@ def soak_scenes(count, seed, cluster=None):
         ),
         count,
     )
-    return tally_scenes(tasks, outcomes) + (lost,)
+    return tally_scenes(tasks, outcomes) + (lost, scene_times(outcomes))
 
 
 def tally_scenes(tasks, outcomes):
@@ -169,6 +189,7 @@ def tally_scenes(tasks, outcomes):
     worst = []
     crashes = []
     stops = []
+    tunnelled = []
     for index, ((scene, t_end), outcome) in enumerate(zip(tasks, outcomes, strict=True)):
         if outcome is None:
             continue
@@ -183,7 +204,9 @@ def tally_scenes(tasks, outcomes):
         tally["steps"] += result.steps
         rejected.update({k: result.rejections[k] for k in REASONS})
         tally["non-finite"] += not result.finite
-        tally["tunnelling"] += result.penetration > GROUND_TOLERANCE or result.intrusion > 0.0
+        if result.penetration > GROUND_TOLERANCE or result.intrusion > 0.0:
+            tally["tunnelling"] += 1
+            tunnelled.append((index, result.penetration, result.intrusion))
         tally["deepest"] = max(tally["deepest"], result.penetration)
         above_start = result.energy_growth > ENERGY_ROUND_OFF
         grew = result.energy_growth > ENERGY_ROUND_OFF + result.collision_gain
@@ -206,6 +229,7 @@ def tally_scenes(tasks, outcomes):
             ends[key if key and result.documented else f"undocumented: {result.error[:80]}"] += 1
             stops.append((index, key or result.error[:80], outcome.t_reached, t_end, scene))
     worst.sort(key=lambda w: -w[0])
+    tally["tunnelled"] = tunnelled
     return tally, rejected, ends, growth, removed, worst, crashes, stops
 
 
@@ -266,7 +290,7 @@ def main():
     parser.add_argument("--out", type=pathlib.Path, default=RESULTS / "soak.md", help="the report's path")
     args = parser.parse_args()
     start = time.perf_counter()
-    tally, rejected, ends, growth, removed, worst, crashes, stops, lost = soak_scenes(
+    tally, rejected, ends, growth, removed, worst, crashes, stops, lost, times = soak_scenes(
         args.scenes, args.seed, check_cluster(args.cluster)
     )
     scene_time = time.perf_counter() - start
@@ -305,11 +329,16 @@ def main():
         "",
         "Rejected steps by reason: " + ", ".join(f"{k} {rejected[k]:,}" for k in REASONS) + ".",
         "",
+        *times,
         f"Newton's rescue (`Scene.newton_rescue_max_iter`) took {tally['rescued steps']:,} steps in "
         f"{tally['rescued runs']} runs (each a run that stopped at `dt_min` without it).",
         "",
         f"Deepest node below a ground in any accepted state: {tally['deepest']:.2g} m (tolerance "
-        f"{GROUND_TOLERANCE:g} m).",
+        f"{GROUND_TOLERANCE:g} m)."
+        + "".join(
+            f" Scene {i}: {depth:.2g} m below a ground, {inside:.2g} m inside another ring."
+            for i, depth, inside in tally["tunnelled"]
+        ),
         "",
         "| how the run ended | runs |",
         "|---|---:|",
