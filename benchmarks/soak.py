@@ -147,13 +147,15 @@ def scene_times(outcomes, cores=(1, 2, 64)):
     """Lines of the report on the scenes' run times: their sum, the longest, and the least wall time
     the scenes can take on each number of ``cores`` (one scene runs on one core):
     ``max(sum / cores, longest)``."""
-    times = [o.seconds for o in outcomes if o is not None]
-    longest = sorted(range(len(times)), key=lambda i: -times[i])[:5]
-    total = sum(times)
-    least = ", ".join(f"{c} cores {max(total / c, times[longest[0]]) / 60:.1f} min" for c in cores)
+    times = {index: o.seconds for index, o in enumerate(outcomes) if o is not None}  # lost: left out
+    longest = sorted(times, key=lambda i: -times[i])[:5]
+    total = sum(times.values())
+    least = ", ".join(
+        f"{c} core{'s' if c > 1 else ''} {max(total / c, times[longest[0]]) / 60:.1f} min" for c in cores
+    )
     return [
         f"Run time of the scenes (each in the process that ran it): {total / 60:.1f} min in all, median "
-        f"{1e3 * float(np.median(times)):.0f} ms, longest "
+        f"{1e3 * float(np.median(list(times.values()))):.0f} ms, longest "
         + ", ".join(f"{times[i]:.1f} s (scene {i})" for i in longest)
         + f". Least wall time of the scenes on a cluster, from these times: {least}.",
         "",
