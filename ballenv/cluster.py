@@ -49,13 +49,6 @@ class TaskLost:
     reason: str
 
 
-@dataclasses.dataclass
-class WarmTime:
-    """How long ``warm`` took on each node (s), by Ray node id; filled by :func:`run_tasks`."""
-
-    seconds: dict[str, float] = dataclasses.field(default_factory=dict)
-
-
 def check_cluster(cluster: str | None) -> str | None:
     """``cluster`` if it names a cluster (:func:`run_tasks`); a ValueError naming it otherwise."""
     if cluster is None or (isinstance(cluster, str) and cluster.strip()):
@@ -101,8 +94,8 @@ def connect(
     return True
 
 
-def warm_nodes(warm: Callable[[], Any]) -> WarmTime:
-    """Run ``warm`` once on each alive node with CPUs, all nodes at once; its time per node."""
+def warm_nodes(warm: Callable[[], Any]) -> dict[str, float]:
+    """Run ``warm`` once on each alive node with CPUs, all nodes at once; its time (s) by node id."""
     ray = _ray()
     from ray.util.scheduling_strategies import NodeAffinitySchedulingStrategy
 
@@ -117,7 +110,7 @@ def warm_nodes(warm: Callable[[], Any]) -> WarmTime:
         timed.options(scheduling_strategy=NodeAffinitySchedulingStrategy(n, soft=False)).remote()
         for n in nodes
     ]
-    return WarmTime(dict(zip(nodes, ray.get(refs), strict=True)))
+    return dict(zip(nodes, ray.get(refs), strict=True))
 
 
 def warm_simulator(run: Callable[..., Any] | None = None) -> None:
@@ -175,14 +168,13 @@ def run_tasks(
     num_cpus: int | None = None,
     max_retries: int = RETRIES,
     warm: Callable[[], Any] | None = None,
-    warm_time: WarmTime | None = None,
     paths: Sequence[str] = (),
     progress: bool = True,
 ) -> Iterator[tuple[int, Any]]:
     """``(index, fn(items[index]))`` for every item, as the tasks finish (in order when serial); a
     task lost with its worker after ``max_retries`` retries gives ``(index, TaskLost)``. ``cluster``,
-    ``warm``, ``paths``: the module docstring and :func:`connect`; ``warm_time`` receives ``warm``'s
-    time per node. ``fn`` and the items must pickle (a module-level function) for a cluster."""
+    ``warm``, ``paths``: the module docstring and :func:`connect` (the warm-up's time is written
+    above the progress bar). ``fn`` and the items must pickle (a module-level function) for a cluster."""
     check_cluster(cluster)
     if isinstance(max_retries, bool) or not isinstance(max_retries, int) or max_retries < 0:
         raise ValueError(f"run_tasks.max_retries = {max_retries!r} is invalid: must be an integer >= 0")
@@ -193,9 +185,10 @@ def run_tasks(
         started = connect(cluster, num_cpus, paths)
         try:
             if warm is not None:
-                timing = warm_nodes(warm)
-                if warm_time is not None:
-                    warm_time.seconds.update(timing.seconds)
+                seconds = warm_nodes(warm)
+                if progress:
+                    longest = max(seconds.values())
+                    bar.write(f"numba's cache warmed on {len(seconds)} node(s) in {longest:.1f} s")
             yield from _on_ray(fn, items, bar, max_retries)
         finally:
             if started:
