@@ -153,7 +153,11 @@ def _on_ray(fn, items, bar, max_retries) -> Iterator[tuple[int, Any]]:
         index = index_of.pop(ref)
         try:
             result = ray.get(ref)
-        except (ray.exceptions.WorkerCrashedError, ray.exceptions.NodeDiedError) as died:
+        except (
+            ray.exceptions.WorkerCrashedError,
+            ray.exceptions.OutOfMemoryError,
+            ray.exceptions.NodeDiedError,
+        ) as died:
             result = TaskLost(index, f"{type(died).__name__}: {str(died).splitlines()[0]}")
         bar.update()
         yield index, result

@@ -38,6 +38,7 @@ import traceback  # noqa: E402
 from collections import Counter  # noqa: E402
 from dataclasses import dataclass, replace  # noqa: E402
 from functools import partial  # noqa: E402
+from typing import NamedTuple  # noqa: E402
 
 import numpy as np  # noqa: E402
 from tqdm.auto import tqdm  # noqa: E402
@@ -170,7 +171,8 @@ def draw_scenes(count, seed):
 
 def soak_scenes(count, seed, cluster=None):
     """Run the soak's scenes (in this process, or as Ray tasks on ``cluster``: ballenv.cluster) and
-    tally them in scene order, so the tallies do not depend on where or in which order they ran."""
+    tally them in scene order, so the tallies do not depend on where or in which order they ran:
+    ``(SceneTallies, the tasks lost with their worker, the report's lines on the run times)``."""
     tasks = draw_scenes(count, seed)
     outcomes, lost = collect(
         run_tasks(
@@ -178,11 +180,27 @@ def soak_scenes(count, seed, cluster=None):
         ),
         count,
     )
-    return tally_scenes(tasks, outcomes) + (lost, scene_times(outcomes))
+    return tally_scenes(tasks, outcomes), lost, scene_times(outcomes)
+
+
+class SceneTallies(NamedTuple):
+    """The report's tallies of the scenes: counts (``tally``), rejected steps by reason, how the
+    runs ended, energy growth and the energy the budget removed per integrator, the largest rises,
+    the crashes, the stops and the scenes with a node below a ground or inside another ring."""
+
+    tally: Counter
+    rejected: Counter
+    ends: Counter
+    growth: dict
+    removed: dict
+    worst: list
+    crashes: list
+    stops: list
+    tunnelled: list
 
 
 def tally_scenes(tasks, outcomes):
-    """The report's tallies of the scenes' outcomes (None: a task lost with its worker)."""
+    """The :class:`SceneTallies` of the scenes' outcomes (None: a task lost with its worker)."""
     tally = Counter()
     rejected = Counter()
     ends = Counter()
@@ -231,8 +249,7 @@ def tally_scenes(tasks, outcomes):
             ends[key if key and result.documented else f"undocumented: {result.error[:80]}"] += 1
             stops.append((index, key or result.error[:80], outcome.t_reached, t_end, scene))
     worst.sort(key=lambda w: -w[0])
-    tally["tunnelled"] = tunnelled
-    return tally, rejected, ends, growth, removed, worst, crashes, stops
+    return SceneTallies(tally, rejected, ends, growth, removed, worst, crashes, stops, tunnelled)
 
 
 POLICIES = ("uniform", "plus", "minus", "alternating")
@@ -292,9 +309,8 @@ def main():
     parser.add_argument("--out", type=pathlib.Path, default=RESULTS / "soak.md", help="the report's path")
     args = parser.parse_args()
     start = time.perf_counter()
-    tally, rejected, ends, growth, removed, worst, crashes, stops, lost, times = soak_scenes(
-        args.scenes, args.seed, check_cluster(args.cluster)
-    )
+    tallies, lost, times = soak_scenes(args.scenes, args.seed, check_cluster(args.cluster))
+    tally, rejected, ends, growth, removed, worst, crashes, stops, tunnelled = tallies
     scene_time = time.perf_counter() - start
     episodes = soak_episodes(args.episodes, args.seed + 1)
     wall = time.perf_counter() - start
@@ -339,7 +355,7 @@ def main():
         f"{GROUND_TOLERANCE:g} m)."
         + "".join(
             f" Scene {i}: {depth:.2g} m below a ground, {inside:.2g} m inside another ring."
-            for i, depth, inside in tally["tunnelled"]
+            for i, depth, inside in tunnelled
         ),
         "",
         "| how the run ended | runs |",

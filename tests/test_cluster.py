@@ -49,14 +49,14 @@ def cluster(local_ray):
 
 def test_the_soak_on_ray_tallies_as_the_serial_run(cluster):
     soak = load_benchmark("soak")
-    serial = soak.soak_scenes(12, seed=0)
-    on_ray = soak.soak_scenes(12, seed=0, cluster=cluster)
-    assert on_ray[8] == [] and serial[8] == []  # no task lost
-    tally, rejected, ends = on_ray[:3]
+    serial, serial_lost, _ = soak.soak_scenes(12, seed=0)
+    on_ray, ray_lost, _ = soak.soak_scenes(12, seed=0, cluster=cluster)
+    assert ray_lost == [] and serial_lost == []
+    tally, ends = on_ray.tally, on_ray.ends
     assert tally["cases"] == 12 and ends["reached t_end"] == 11  # scene 0 stops early
     assert not any(how.startswith(("undocumented", "crash")) for how in ends)
     assert on_ray[:3] == serial[:3]
-    assert [s[:4] for s in on_ray[7]] == [s[:4] for s in serial[7]]  # the stops, scene by scene
+    assert [s[:4] for s in on_ray.stops] == [s[:4] for s in serial.stops]  # scene by scene
 
 
 def test_a_scene_grid_on_ray_is_the_serial_grid_to_the_bit(cluster):
