@@ -7,8 +7,17 @@ touches its bottom, a crumpled wall) repel through the potential of Incremental 
     E = kappa dhat^2 beta(d^2 / dhat^2),   beta(y) = -(y - 1)^2 ln y   (0 < y < 1; 0 for y >= 1)
 
 with ``dhat`` = the wall thickness ``h`` (m; the barrier acts while the two centrelines are closer
-than one wall thickness) and ``kappa = EA / l_0`` (N/m; the axial stiffness of one edge, so the
-barrier is about as stiff as the wall it keeps apart). ``E`` (J) is ``C^2`` in the positions, zero
+than one wall thickness) and
+
+    kappa = max(EA / l_0, K_0 / (dhat^2 beta(STOP_GAP^2)))                         [N/m]
+
+the axial stiffness of one edge (the barrier about as stiff as the wall it keeps apart) or, if
+larger, the stiffness at which the ring's kinetic energy at the start ``K_0`` (J,
+``Model.start_energy``) is spent before a pair comes closer than ``STOP_GAP dhat``. The log grows
+slowly: at ``EA / l_0`` alone a thin wall thrown at 20-30 m/s had node-edge pairs pushed to 1e-5
+``dhat``, where round-off decides whether even a 1 ns step crosses the wall. (IPC raises its
+stiffness during a run when distances get that small; fixed for the run, the potential stays
+conservative.) ``E`` (J) is ``C^2`` in the positions, zero
 with its first two derivatives at ``d = dhat``, and grows without bound as ``d -> 0``: the
 potential is conservative (its energy is part of the ring's energy budget) and no state with
 ``d = 0`` has finite energy. ``d^2`` is the squared distance from ``p`` to the segment: to the line
@@ -50,6 +59,8 @@ MIN_ARC_EDGES = 1  # and pairs nearer than this many edges (a node and its own t
 CCD_SAFETY = 0.8  # a correction that would make a node meet an edge is cut to this fraction
 BAND_REACH = 4  # node blocks within this many zig-zag positions fit the band (linalg.BAND_HALF_WIDTH)
 PAIRS_PER_NODE = 16  # room for candidate pairs
+STOP_GAP = 0.1  # the start energy alone cannot push a pair closer than this fraction of dhat
+STOP_BETA = -((STOP_GAP**2 - 1.0) ** 2) * math.log(STOP_GAP**2)  # beta(STOP_GAP^2)
 
 
 # ----------------------------------------------------------------------------- the potential
@@ -81,8 +92,8 @@ def beta_curvature(y):
 
 @kernel(inline="always")
 def stiffness(model, r):
-    """``kappa = EA / l_0`` (N/m) of ring ``r``."""
-    return model.ea[r] / model.rest_len[r]
+    """``kappa`` (N/m) of ring ``r``: ``max(EA / l_0, K_0 / (dhat^2 STOP_BETA))`` (module doc)."""
+    return max(model.ea[r] / model.rest_len[r], model.start_energy[r] / (model.thickness[r] ** 2 * STOP_BETA))
 
 
 @kernel(inline="always")

@@ -109,7 +109,7 @@ def self_contact_energy(model, r, x, bw):
     workspace (``bw`` None)."""
     if bw is None:
         return 0.0
-    limits = wall_limit_energy(x, model.rest_len[r], model.ea[r])
+    limits = wall_limit_energy(x, model.rest_len[r], model.ea[r], model.start_energy[r])
     if near_pairs(x, model.rest_len[r], reach(model, r), bw) == 0:
         return limits  # (no sweep where the step's end was found clear)
     count = find_pairs(x, x, model.rest_len[r], reach(model, r), bw)

@@ -68,6 +68,7 @@ class Model(NamedTuple):
     impulse_bound: np.ndarray  # (R,) N s: the adaptive step's largest contact impulse per step
     rest_energy: np.ndarray  # (R,) J: stretching + gas energy of the inflated circle at rest
     thickness: np.ndarray  # (R,) m: wall thickness (the contact distance of two rings is h_a + h_b)
+    start_energy: np.ndarray  # (R,) J: kinetic energy at the start, which the barriers are sized to stop
     collide: bool  # ring-ring collision (two or more rings and Scene.ring_collision)
     reject_self_intersection: bool  # reject trial states in which a ring crosses itself
     self_barrier: bool  # the self-contact barrier of far wall parts (barrier.py)
@@ -90,7 +91,7 @@ class Drive(NamedTuple):
 # Model fields with one entry per ring (the rest are scene-wide): a view of rings [a, b) slices these
 PER_RING_FIELDS = (
     "node_mass", "ea", "ei", "rest_len", "rest_turn", "width", "radius", "pressurised", "gas_constant",
-    "rest_energy", "thickness", "effect_parameters", "impulse_bound",
+    "rest_energy", "thickness", "start_energy", "effect_parameters", "impulse_bound",
 )  # fmt: skip
 
 
@@ -287,6 +288,7 @@ def build_model(scene, effects=EFFECTS):
         impulse_bound=impulse_bounds(scene),
         rest_energy=np.zeros(len(rings)),
         thickness=np.array([r.thickness for r in rings]),
+        start_energy=np.array([start_kinetic_energy(r) for r in rings]),
         collide=len(rings) > 1 and scene.ring_collision,
         reject_self_intersection=scene.self_intersection in ("reject", "barrier"),
         self_barrier=scene.self_intersection == "barrier",
@@ -295,6 +297,15 @@ def build_model(scene, effects=EFFECTS):
     )
     _fill_rest_energy(model, rings)
     return model
+
+
+def start_kinetic_energy(ring):
+    """Kinetic energy (J) of ``ring``'s start (its inflated circle in rigid motion:
+    ``Ring.velocity``, ``angular_velocity``): ``m/2 sum_i |v_i|^2``. The self-contact barrier, the
+    wall limits and the contact between rings are made stiff enough to stop it
+    (:func:`barrier.stiffness`, :mod:`.wall_limits`, :func:`ring_contact.pair_stiffness`)."""
+    _, v = ring_geometry.initial_nodes(ring)
+    return 0.5 * ring_geometry.node_mass(ring) * float(np.sum(v * v))
 
 
 def _fill_rest_energy(model, rings):

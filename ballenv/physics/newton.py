@@ -237,7 +237,7 @@ def add_limit_force(model, r, ws, bw):
     ``ws.xe`` to ``ws.force`` (nothing unless a node folds or an edge collapses that far)."""
     if bw is None:
         return
-    wall_limit_force(ws.xe, model.rest_len[r], model.ea[r], ws.force)
+    wall_limit_force(ws.xe, model.rest_len[r], model.ea[r], model.start_energy[r], ws.force)
 
 
 @kernel
@@ -245,7 +245,7 @@ def add_limit_jacobian(model, r, c_x, ws, bw):
     """In either mode, add ``c_x`` times the wall limits' Hessian at ``ws.xe`` to the band."""
     if bw is None:
         return
-    wall_limit_jacobian(ws.xe, model.rest_len[r], model.ea[r], c_x, ws.band, ws.pos)
+    wall_limit_jacobian(ws.xe, model.rest_len[r], model.ea[r], model.start_energy[r], c_x, ws.band, ws.pos)
 
 
 @kernel

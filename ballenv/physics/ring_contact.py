@@ -8,8 +8,10 @@ potential of Incremental Potential Contact (Li et al., ACM TOG 2020) on their di
 
 with the contact distance ``dhat = h_a + h_b`` (m; the sum of the wall thicknesses, "twice the
 thickness" for equal rings: the distance at which the explicit collision impulses act) and
-``kappa = min(EA_a / l_a, EA_b / l_b)`` (N/m: the axial stiffness of one edge of the softer ring,
-the self barrier's choice for one ring). ``E`` (J) is ``C^2``, zero with its first two
+``kappa = max(min(EA_a / l_a, EA_b / l_b), (K_a + K_b) / (dhat^2 beta(STOP_GAP^2)))`` (N/m: the
+axial stiffness of one edge of the softer ring or, if larger, the stiffness that spends the two
+rings' kinetic energies at the start before they come closer than ``STOP_GAP dhat``; the self
+barrier's choice for one ring, :func:`barrier.stiffness`). ``E`` (J) is ``C^2``, zero with its first two
 derivatives at ``d = dhat``, infinite at ``d = 0``: a conservative potential, part of the scene's
 energy. Its force and exact Hessian are those of :mod:`.barrier` (``point_edge_derivatives``).
 
@@ -33,6 +35,7 @@ import math
 from typing import TYPE_CHECKING
 
 from .barrier import (
+    STOP_BETA,
     beta,
     beta_curvature,
     beta_slope,
@@ -65,8 +68,11 @@ def pairs_per_node(model: "Model") -> int:
 
 @kernel(inline="always")
 def pair_stiffness(model, a, b):
-    """``kappa`` (N/m): the smaller of rings ``a`` and ``b``'s edge stiffnesses ``EA / l_0``."""
-    return min(model.ea[a] / model.rest_len[a], model.ea[b] / model.rest_len[b])
+    """``kappa`` (N/m) of rings ``a`` and ``b``: the smaller of their edge stiffnesses ``EA / l_0``,
+    or the stiffness that stops their start energies (module doc), whichever is larger."""
+    edge = min(model.ea[a] / model.rest_len[a], model.ea[b] / model.rest_len[b])
+    reach = pair_reach(model, a, b)
+    return max(edge, (model.start_energy[a] + model.start_energy[b]) / (reach * reach * STOP_BETA))
 
 
 @kernel(inline="always")

@@ -398,7 +398,7 @@ def joint_newton(model, solver, state, v0, trial, h, ws, rc):
 
 
 @kernel
-def contact_transfers(model, x0, x1, before, after, rc):
+def contact_transfers(model, x0, x1, before, after, kicks, rc):
     """``rc.transfer[r]`` (J): the energy the contact between rings gave ring ``r`` in a step from
     ``x0`` to ``x1`` (R, N, 2) m, credited to its energy budget. ``before``, ``after``: the rings'
     energy rows (``layout.ENERGY``) at both ends. The rings in contact (nonzero work
@@ -408,7 +408,10 @@ def contact_transfers(model, x0, x1, before, after, rc):
     sum to ``-dE_c`` exactly, so energy moves between rings, the budgets together gain what the
     contact energy gave up and no more, and a gain ``G > 0`` of the whole stays above the budgets
     (where the energy test finds it). Rings out of contact get nothing. Returns ``G`` (J; NaN if
-    the candidate pairs do not fit)."""
+    the candidate pairs do not fit). ``kicks`` (R,) J: what each ring's own collision impulses at
+    the step's start gave it (:func:`stepper.collision_kicks`, credited to its budget on their
+    own), left out of its ``dE_r`` (counted here too, a self-contact impulse's loss in one ring was
+    shared out by contact work, and credited to that ring twice)."""
     count = find_ring_pairs(model, x0, x1, rc)
     if count < 0:
         return math.nan
@@ -422,9 +425,9 @@ def contact_transfers(model, x0, x1, before, after, rc):
         rc.work[r] = abs(w)
         size += abs(w)
         if w != 0.0:
-            gain += after[r, ENERGY_TOTAL] - before[r, ENERGY_TOTAL]
+            gain += after[r, ENERGY_TOTAL] - before[r, ENERGY_TOTAL] - kicks[r]
     for r in range(x0.shape[0]):
-        changed = after[r, ENERGY_TOTAL] - before[r, ENERGY_TOTAL]
+        changed = after[r, ENERGY_TOTAL] - before[r, ENERGY_TOTAL] - kicks[r]
         rc.transfer[r] = changed - rc.work[r] / size * gain if rc.work[r] > 0.0 else 0.0
     return gain
 

@@ -256,7 +256,8 @@ class Simulation:
     Args:
         scene: the :class:`Scene`.
         x0, v0: optional initial node positions (m) and velocities (m/s), shape (n_rings, n_nodes, 2)
-            (or (n_nodes, 2) for one ring).
+            (or (n_nodes, 2) for one ring). The contact barriers' stiffness follows the scene's own
+            start (``Ring.velocity``, ``angular_velocity``: ``Model.start_energy``), also with these.
         output_dt: record interval (s); None records every accepted step.
         expected_end: the time (s) the run is expected to reach, to size the recording (it grows).
         effects: the force effects summed on each ring: the registry ``ballenv.physics.effects.EFFECTS``

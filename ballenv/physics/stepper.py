@@ -168,7 +168,8 @@ def joint_energy(model, state, trial, ws, rc):
     at rest on their grounds; tallied as removed). False if the pairs do not fit."""
     for r in range(state.x.shape[0]):
         free_energy(model, r, trial.x[r], trial.v[r], ws, trial.energy[r])
-    gain = contact_transfers(model, state.x, trial.x, state.energy, trial.energy, rc)
+    kicks = ws.collision.kinetic_change  # (always found: rings that collide through the barrier)
+    gain = contact_transfers(model, state.x, trial.x, state.energy, trial.energy, kicks, rc)
     if gain > 0.0 and pay_from_relative_motion(model, trial.v, rc, gain):
         ws.energy_tally[TALLY_PROJECTED] += 1.0
         ws.energy_tally[TALLY_REMOVED] += gain
@@ -176,7 +177,7 @@ def joint_energy(model, state, trial, ws, rc):
             if rc.work[r] > 0.0:
                 rest_on_grounds(ws.surface, trial.active[r], trial.x[r], trial.v[r], trial.a[r])
                 free_energy(model, r, trial.x[r], trial.v[r], ws, trial.energy[r])
-        gain = contact_transfers(model, state.x, trial.x, state.energy, trial.energy, rc)
+        gain = contact_transfers(model, state.x, trial.x, state.energy, trial.energy, kicks, rc)
     return not math.isnan(gain)
 
 

@@ -12,7 +12,7 @@ each only near its limit, so a ring that never folds or collapses that far is no
 * **Fold limit**, per node: with ``u = 1 + cos(phi)`` (0 folded shut, 2 straight) and ``u_on = 1 +
   cos(FOLD_ON)``,
 
-      E_f = k_f beta(u / u_on),   k_f = 2 u_on EA l0                              [J]
+      E_f = k_f beta(u / u_on),   k_f = max(2 u_on EA l0, K_0 / beta(STOP_Y))      [J]
 
   active while ``|phi| > FOLD_ON``. For a fold of ``theta = pi - |phi|`` the next node is at
   ``d ~ l0 theta`` from the previous edge's line and ``u ~ theta^2 / 2 = d^2 / (2 l0^2)``: ``E_f``
@@ -22,11 +22,16 @@ each only near its limit, so a ring that never folds or collapses that far is no
   hess phi`` (bending's ``grad phi``, ``hess phi``: :mod:`.effects.bending`).
 * **Collapse limit**, per edge of length ``L``: with ``s = COLLAPSE_ON l0``,
 
-      E_c = k_c beta(L^2 / s^2),   k_c = EA s^2 / l0                              [J]
+      E_c = k_c beta(L^2 / s^2),   k_c = max(EA s^2 / l0, K_0 / beta(STOP_Y))     [J]
 
   active while ``L < s`` (the self-contact barrier with ``kappa = EA / l0``, ``dhat = s``, ``d =
   L``). ``grad L^2 = 2 e`` at the edge's end, ``-2 e`` at its start.
 
+With ``K_0`` the ring's kinetic energy at the start (J, ``Model.start_energy``): where the wall's
+own stiffness is too soft to spend it, ``k`` is raised so that it is spent before ``y`` falls to
+``STOP_Y`` (a fold of at most 171 degrees, an edge of at least 0.079 ``l0``), as the self-contact
+barrier's ``kappa`` is (:func:`barrier.stiffness`): a thick, soft ring thrown at 15-30 m/s had edges
+crushed to 1e-6 ``l0``, where bending's turning angles change by tens of degrees over a 1 ns step.
 Both grow without bound at the limit (``phi = +-pi``, ``L = 0``), so no state with finite energy
 reaches it; their energy is part of the self-contact energy of the energy budget
 (:func:`energy.self_contact_energy`). A straight motion of the nodes (a Newton correction, the
@@ -47,18 +52,21 @@ FOLD_ON = math.radians(150.0)  # rad: turning angle beyond which the fold limit 
 FOLD_U = 1.0 + math.cos(FOLD_ON)  # u_on
 COLLAPSE_ON = 0.25  # edge length (fraction of l0) below which the collapse limit acts
 SHRINK_FLOOR = 0.1  # a motion may shrink an edge to this fraction of its length, no further
+STOP_Y = 0.1  # the start energy alone cannot push y = u / u_on or L^2 / s^2 below this
+STOP_BETA = -((STOP_Y - 1.0) ** 2) * math.log(STOP_Y)  # beta(STOP_Y)
 
 
 @kernel(inline="always")
-def fold_stiffness(ea, rest_len):
-    """``k_f = 2 u_on EA l0`` (J)."""
-    return 2.0 * FOLD_U * ea * rest_len
+def fold_stiffness(ea, rest_len, energy):
+    """``k_f = max(2 u_on EA l0, K_0 / beta(STOP_Y))`` (J) for start energy ``K_0 = energy`` (J)."""
+    return max(2.0 * FOLD_U * ea * rest_len, energy / STOP_BETA)
 
 
 @kernel(inline="always")
-def collapse_stiffness(ea, rest_len):
-    """``k_c = EA s^2 / l0 = EA COLLAPSE_ON^2 l0`` (J)."""
-    return ea * COLLAPSE_ON * COLLAPSE_ON * rest_len
+def collapse_stiffness(ea, rest_len, energy):
+    """``k_c = max(EA s^2 / l0, K_0 / beta(STOP_Y))`` (J), ``s = COLLAPSE_ON l0``, for start energy
+    ``K_0 = energy`` (J)."""
+    return max(ea * COLLAPSE_ON * COLLAPSE_ON * rest_len, energy / STOP_BETA)
 
 
 @kernel(inline="always")
@@ -77,12 +85,13 @@ def fold_terms(phi, k):
 
 
 @kernel
-def wall_limit_energy(x, rest_len, ea):
-    """Energy (J) of both limits of a ring with nodes ``x`` (N, 2) m: 0 unless a node folds beyond
+def wall_limit_energy(x, rest_len, ea, energy):
+    """Energy (J) of both limits of a ring with nodes ``x`` (N, 2) m, rest edge length ``rest_len``
+    (m), ``EA = ea`` (N) and start energy ``K_0 = energy`` (J): 0 unless a node folds beyond
     ``FOLD_ON`` or an edge is shorter than ``COLLAPSE_ON l0``; inf at a limit."""
     n = x.shape[0]
-    kf = fold_stiffness(ea, rest_len)
-    kc = collapse_stiffness(ea, rest_len)
+    kf = fold_stiffness(ea, rest_len, energy)
+    kc = collapse_stiffness(ea, rest_len, energy)
     s2 = (COLLAPSE_ON * rest_len) ** 2
     total = 0.0
     for i in range(n):
@@ -96,12 +105,12 @@ def wall_limit_energy(x, rest_len, ea):
 
 
 @kernel
-def wall_limit_force(x, rest_len, ea, f):
+def wall_limit_force(x, rest_len, ea, energy, f):
     """Add ``-grad (E_f + E_c)`` (N) at nodes ``x`` (N, 2) m to ``f``; a node folded shut or an edge
     of zero length adds inf."""
     n = x.shape[0]
-    kf = fold_stiffness(ea, rest_len)
-    kc = collapse_stiffness(ea, rest_len)
+    kf = fold_stiffness(ea, rest_len, energy)
+    kc = collapse_stiffness(ea, rest_len, energy)
     s2 = (COLLAPSE_ON * rest_len) ** 2
     for i in range(n):
         e1x, e1y, e2x, e2y = _edges(x, i, n)
@@ -130,12 +139,12 @@ def wall_limit_force(x, rest_len, ea, f):
 
 
 @kernel
-def wall_limit_jacobian(x, rest_len, ea, coef, band, pos):
+def wall_limit_jacobian(x, rest_len, ea, energy, coef, band, pos):
     """Add ``coef hess (E_f + E_c)`` at nodes ``x`` (N, 2) m to ``band`` (node blocks by ``pos``; a
     node's blocks reach its neighbours' neighbours, as bending's do)."""
     n = x.shape[0]
-    kf = fold_stiffness(ea, rest_len)
-    kc = collapse_stiffness(ea, rest_len)
+    kf = fold_stiffness(ea, rest_len, energy)
+    kc = collapse_stiffness(ea, rest_len, energy)
     s2 = (COLLAPSE_ON * rest_len) ** 2
     for i in range(n):
         e1x, e1y, e2x, e2y = _edges(x, i, n)

@@ -8,6 +8,7 @@ import pytest
 
 from ballenv.physics import Ground, Ring, Scene, Simulation, simulate
 from ballenv.physics.barrier import (
+    STOP_GAP,
     barrier_energy,
     barrier_force,
     barrier_jacobian,
@@ -21,12 +22,15 @@ from ballenv.physics.barrier import (
     point_edge_derivatives,
     point_edge_distance2,
     point_edge_impact,
+    stiffness,
 )
 from ballenv.physics.collision import self_intersects
 from ballenv.physics.layout import ENERGY_TOTAL
 from ballenv.physics.linalg import band_to_dense
 from ballenv.physics.model import build_model, build_workspace
+from ballenv.physics.ring import inflated_radius, total_mass
 from ballenv.physics.simulation import initial_state
+from tests.stability.invariants import audit
 
 # p, a, b with the foot of p on the segment, beyond a, and beyond b
 CONFIGURATIONS = {
@@ -281,3 +285,85 @@ def test_the_rolling_rings_of_figure_8_complete_with_walls_of_2_5_mm():
         heights.append(np.mean(up.max(axis=1)[-100:] - up.min(axis=1)[-100:]))
     assert np.all(np.diff(heights) > 0.0)  # the rolling shape is taller the stiffer the wall
     assert heights[0] < 0.3 * 2 * radius  # the softest rolls folded
+
+
+def test_the_barrier_is_stiff_enough_to_spend_the_rings_start_energy():
+    """``kappa = max(EA / l0, K_0 / (dhat^2 beta(STOP_GAP^2)))``: a ring at rest keeps its edges'
+    stiffness; thrown, its kinetic energy ``K_0`` is spent before a pair comes within ``STOP_GAP
+    dhat``."""
+    ring = Ring(pressure=None, thickness=1e-3)
+    at_rest = build_model(Scene(rings=[ring]))
+    assert at_rest.start_energy[0] == 0.0
+    assert stiffness(at_rest, 0) == at_rest.ea[0] / at_rest.rest_len[0]
+    thrown = build_model(Scene(rings=[replace(ring, velocity=(20.0, -20.0), angular_velocity=30.0)]))
+    k0 = thrown.start_energy[0]
+    assert k0 == pytest.approx(0.5 * total_mass(ring) * (800.0 + (30.0 * inflated_radius(ring)) ** 2))
+    assert stiffness(thrown, 0) > 10.0 * stiffness(at_rest, 0)  # (61 times here)
+    assert stiffness(thrown, 0) * ring.thickness**2 * beta(STOP_GAP**2) == pytest.approx(k0, rel=1e-12)
+
+
+def _soak_scene(index):
+    """Two thin walls thrown fast, from the soak (seed 0), and their end times."""
+    if index == 392:  # h/R = 0.006, 30 m/s and 33 rad/s onto flat ground
+        ring = Ring(
+            radius=0.2251346740756372,
+            n_nodes=64,
+            youngs_modulus=458156.2762226351,
+            thickness=0.0013643996781591162,
+            width=0.09523869405771865,
+            density=1031.5075085367903,
+            pressure=519.9281373067845,
+            position=(0.0, 0.5699005690151531),
+            velocity=(13.731044865271038, -27.050777403030427),
+            angular_velocity=33.398045121902356,
+        )
+        return Scene(
+            rings=[ring],
+            grounds=[Ground(friction=1.4909735440943468)],
+            contact="predictor_corrector",
+            gravity=12.717321730575042,
+            damping=0.0,
+            rho_infinity=0.8085577370208539,
+            dt=0.00016664823933942004,
+            adaptive=True,
+            atmospheric_pressure=0.0,
+            gas_exponent=1.4,
+        ), 0.10049042430412317
+    # 1103: h/R = 0.008, empty, 28 m/s and 49 rad/s onto an 8 degree slope
+    ring = Ring(
+        radius=0.2727413811620114,
+        n_nodes=32,
+        youngs_modulus=222478.60937027074,
+        thickness=0.002251771827540602,
+        width=0.058159962633964904,
+        density=262.5472196851116,
+        pressure=None,
+        position=(-0.03857997180564954, 0.27392126651429904),
+        velocity=(7.750873881583246, -27.2387550442769),
+        angular_velocity=48.91430368302153,
+    )
+    return Scene(rings=[ring], grounds=[Ground(angle=0.13992292273830773, friction=1.1276668678395967)],
+                 contact="predictor_corrector", gravity=5.332680929239819, damping=50.0,
+                 rho_infinity=0.9468670816202109, dt=0.004777778224637557, adaptive=True,
+                 atmospheric_pressure=0.0, gas_exponent=1.0), 0.06485330018586018  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    ("index", "stop"), [(392, "a ring's wall crossed itself"), (1103, "the step gained energy")]
+)
+def test_thin_walls_thrown_fast_complete_with_the_barriers_sized_to_their_energy(index, stop):
+    """With the edges' stiffness alone (the same start given as x0, v0 to a scene whose rings are at
+    rest) these runs stopped at dt_min: in 392 a node was pushed to 1e-5 of the wall thickness from
+    an edge, and round-off decided whether a 1 ns step crossed it; in 1103 a fold past 150 degrees.
+    With the barrier and the wall limits sized to the start energy they reach their end, every
+    invariant held (no crossing, nothing below the ground, no energy made)."""
+    scene, t_end = _soak_scene(index)
+    x0, v0 = initial_state(scene)
+    at_rest = replace(
+        scene, rings=[replace(r, velocity=(0.0, 0.0), angular_velocity=0.0) for r in scene.rings]
+    )
+    weak = Simulation(at_rest, x0=x0, v0=v0)
+    assert not weak.advance(t_end) and stop in weak.failure
+    result = audit(scene, t_end)
+    assert result.reached_end and result.problems() == [], result
+    assert not any(self_intersects(xk[0]) for xk in result.traj.x)

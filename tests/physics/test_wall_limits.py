@@ -16,6 +16,7 @@ from ballenv.physics.wall_limits import (
     FOLD_ON,
     FOLD_U,
     SHRINK_FLOOR,
+    STOP_Y,
     collapse_stiffness,
     fold_stiffness,
     limit_fraction,
@@ -60,39 +61,51 @@ def _closed_form(x):
     total = 0.0
     for i in range(n):
         y = (1 + math.cos(_turn(x, i))) / FOLD_U
-        total += fold_stiffness(EA, REST) * beta(y) if y < 1 else 0.0
+        total += fold_stiffness(EA, REST, 0.0) * beta(y) if y < 1 else 0.0
         y = np.sum((x[(i + 1) % n] - x[i]) ** 2) / (COLLAPSE_ON * REST) ** 2
-        total += collapse_stiffness(EA, REST) * beta(y) if y < 1 else 0.0
+        total += collapse_stiffness(EA, REST, 0.0) * beta(y) if y < 1 else 0.0
     return total
 
 
 @pytest.mark.parametrize("turn", [math.radians(170.0), math.radians(-149.0), math.radians(-178.0)])
 def test_energy_is_the_closed_form(turn):
     x = _folded(turn=turn)
-    assert wall_limit_energy(x, REST, EA) > 0.0
-    assert wall_limit_energy(x, REST, EA) == pytest.approx(_closed_form(x), rel=1e-12)
+    assert wall_limit_energy(x, REST, EA, 0.0) > 0.0
+    assert wall_limit_energy(x, REST, EA, 0.0) == pytest.approx(_closed_form(x), rel=1e-12)
     # k_f = 2 u_on EA l0, k_c = EA COLLAPSE_ON^2 l0
-    assert fold_stiffness(EA, REST) == pytest.approx(2 * (1 + math.cos(FOLD_ON)) * EA * REST)
-    assert collapse_stiffness(EA, REST) == pytest.approx(EA * COLLAPSE_ON**2 * REST)
+    assert fold_stiffness(EA, REST, 0.0) == pytest.approx(2 * (1 + math.cos(FOLD_ON)) * EA * REST)
+    assert collapse_stiffness(EA, REST, 0.0) == pytest.approx(EA * COLLAPSE_ON**2 * REST)
+
+
+def test_a_start_energy_the_wall_cannot_spend_raises_both_stiffnesses():
+    """k_f = 2 u_on EA l0 = 10.7 J and k_c = EA s^2 / l0 = 2.5 J here; a start energy K_0 above what
+    they spend at y = STOP_Y sets k = K_0 / beta(STOP_Y): K_0 is spent exactly there."""
+    assert fold_stiffness(EA, REST, 1.0) == fold_stiffness(EA, REST, 0.0)  # the wall's own, stiffer
+    assert collapse_stiffness(EA, REST, 1.0) == collapse_stiffness(EA, REST, 0.0)
+    for k0 in (1e2, 1e4):
+        assert fold_stiffness(EA, REST, k0) * beta(STOP_Y) == pytest.approx(k0, rel=1e-12)
+        assert collapse_stiffness(EA, REST, k0) * beta(STOP_Y) == pytest.approx(k0, rel=1e-12)
+    x = _folded(turn=math.radians(170.0))
+    assert wall_limit_energy(x, REST, EA, 1e4) > 100.0 * wall_limit_energy(x, REST, EA, 0.0)
 
 
 def test_no_energy_away_from_the_limits():
-    assert wall_limit_energy(_circle(), REST, EA) == 0.0  # a rest shape is untouched
+    assert wall_limit_energy(_circle(), REST, EA, 0.0) == 0.0  # a rest shape is untouched
     x = _folded(turn=FOLD_ON - 0.01, short=1.01 * COLLAPSE_ON)
     assert max(abs(_turn(x, i)) for i in range(12)) < FOLD_ON  # (node 1's the sharpest)
-    assert wall_limit_energy(x, REST, EA) == 0.0
+    assert wall_limit_energy(x, REST, EA, 0.0) == 0.0
 
 
 def test_energy_grows_without_bound_at_both_limits():
-    a = [wall_limit_energy(_folded(turn=math.pi - t, short=1.0), REST, EA) for t in (1e-1, 1e-3, 1e-6)]
-    b = [wall_limit_energy(_folded(turn=0.3, short=s), REST, EA) for s in (1e-1, 1e-3, 1e-6)]
+    a = [wall_limit_energy(_folded(turn=math.pi - t, short=1.0), REST, EA, 0.0) for t in (1e-1, 1e-3, 1e-6)]
+    b = [wall_limit_energy(_folded(turn=0.3, short=s), REST, EA, 0.0) for s in (1e-1, 1e-3, 1e-6)]
     assert 0.0 < a[0] < a[1] < a[2] and 0.0 < b[0] < b[1] < b[2]
-    assert wall_limit_energy(_folded(turn=0.3, short=0.0), REST, EA) == math.inf
+    assert wall_limit_energy(_folded(turn=0.3, short=0.0), REST, EA, 0.0) == math.inf
 
 
 def _force(x):
     f = np.zeros_like(x)
-    wall_limit_force(x, REST, EA, f)
+    wall_limit_force(x, REST, EA, 0.0, f)
     return f.ravel()
 
 
@@ -107,14 +120,16 @@ def test_force_and_jacobian_match_finite_differences(turn):
         dx = np.zeros(2 * n)
         dx[k] = eps
         plus, minus = x + dx.reshape(n, 2), x - dx.reshape(n, 2)
-        g_fd[k] = -(wall_limit_energy(plus, REST, EA) - wall_limit_energy(minus, REST, EA)) / (2 * eps)
+        g_fd[k] = -(wall_limit_energy(plus, REST, EA, 0.0) - wall_limit_energy(minus, REST, EA, 0.0)) / (
+            2 * eps
+        )
         j_fd[:, k] = -(_force(plus) - _force(minus)) / (2 * eps)
     f = _force(x)
     assert np.abs(f).max() > 0.0
     np.testing.assert_allclose(f, g_fd, atol=1e-6 * np.abs(g_fd).max())
     ws = build_workspace(n)
     ws.band[:] = 0.0
-    wall_limit_jacobian(x, REST, EA, 1.0, ws.band, ws.pos)
+    wall_limit_jacobian(x, REST, EA, 0.0, 1.0, ws.band, ws.pos)
     dense = band_to_dense(ws.band, ws.pos)
     np.testing.assert_allclose(dense, j_fd, atol=1e-6 * np.abs(j_fd).max())
     np.testing.assert_allclose(dense, dense.T, atol=1e-9 * np.abs(dense).max())
