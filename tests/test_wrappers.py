@@ -11,7 +11,13 @@ import pytest
 
 import ballenv  # noqa: F401  (registers the env)
 from agents.evaluate import evaluate
-from agents.wrappers import BallStateObservation, wrapper_class
+from agents.wrappers import (
+    SHAPE_MODES,
+    BallShapeObservation,
+    BallStateObservation,
+    radial_modes,
+    wrapper_class,
+)
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 
@@ -43,9 +49,71 @@ def test_ball_state_keeps_the_body_fields_and_the_total_ground_force(mode):
                                           "paddle_in_reach", "paddle_impulse")]))  # fmt: skip
 
 
+def ring_observation(env, radius, deform=lambda angle: 0.0, rate=lambda angle: 0.0):
+    """A raw observation of the env under ``env`` whose nodes lie at ``radius + deform(angle)`` (m) from the
+    centre of mass, moving radially at ``rate(angle)`` (m/s), the other entries 0."""
+    s = env.unwrapped.observation_structure
+    n = (s["node_position"].stop - s["node_position"].start) // 2
+    angle = np.linspace(0.0, 2.0 * np.pi, n, endpoint=False) + 0.1
+    direction = np.column_stack([np.cos(angle), np.sin(angle)])
+    obs = np.zeros(env.unwrapped.observation_space.shape, dtype=np.float32)
+    distance = np.broadcast_to(radius + deform(angle), angle.shape)
+    speed = np.broadcast_to(rate(angle), angle.shape)
+    obs[s["node_position"]] = (distance[:, None] * direction).ravel()
+    obs[s["node_velocity"]] = (speed[:, None] * direction).ravel()
+    return obs
+
+
+def test_radial_modes_are_the_fourier_coefficients():
+    angle = np.linspace(0.0, 2.0 * np.pi, 32, endpoint=False)
+    values = 0.5 + 0.2 * np.cos(2 * angle) - 0.3 * np.sin(3 * angle)
+    modes = radial_modes(values, angle, 4)
+    assert modes == pytest.approx([0.5, 0, 0, 0.2, 0, 0, -0.3, 0, 0], abs=1e-12)
+
+
+@pytest.mark.parametrize("mode", ["pressure", "paddle"])
+def test_ball_shape_adds_the_ring_modes_to_the_ball_state(mode):
+    raw = gym.make("InflatedBall-v3", action_mode=mode)
+    env = BallShapeObservation(gym.make("InflatedBall-v3", action_mode=mode))
+    body = BallStateObservation(gym.make("InflatedBall-v3", action_mode=mode))
+    n_shape = 2 * (1 + 2 * SHAPE_MODES)
+    assert env.observation_space.shape == (body.observation_space.shape[0] + n_shape,)
+    obs, _ = env.reset(seed=5)
+    full, _ = raw.reset(seed=5)
+    for _ in range(60):  # into the first contact
+        action = np.array([0.3], dtype=np.float32)
+        obs, *_ = env.step(action)
+        full, *_ = raw.step(action)
+    assert env.observation_space.contains(obs)
+    assert obs[:-n_shape] == pytest.approx(body.observation(full))
+    assert obs[-n_shape:] == pytest.approx(env.shape_modes(full), abs=1e-6)
+
+
+def test_a_round_ring_has_only_the_breathing_mode():
+    env = BallShapeObservation(gym.make("InflatedBall-v3"))
+    r, scale = env.radius, env.speed_scale
+    shape = env.shape_modes(ring_observation(env, 1.1 * r, rate=lambda a: 0.5))
+    displacement, rate = np.split(shape, 2)
+    assert displacement[0] == pytest.approx(0.1, rel=1e-5)  # (1.1 R - R) / R
+    assert rate[0] == pytest.approx(0.5 / scale, rel=1e-5)
+    assert np.abs(displacement[1:]).max() < 1e-6 and np.abs(rate[1:]).max() < 1e-5
+
+
+def test_a_squashed_ring_shows_in_mode_two():
+    env = BallShapeObservation(gym.make("InflatedBall-v3"))
+    r, scale = env.radius, env.speed_scale
+    obs = ring_observation(env, r, deform=lambda a: 0.01 * np.cos(2 * a), rate=lambda a: -0.2 * np.cos(2 * a))
+    displacement, rate = np.split(env.shape_modes(obs), 2)
+    assert displacement[3] == pytest.approx(0.01 / r, rel=1e-3)  # c_2: wider than tall
+    assert rate[3] == pytest.approx(-0.2 / scale, rel=1e-3)
+    others = np.delete(np.arange(displacement.size), 3)
+    assert np.abs(displacement[others]).max() < 1e-3 * 0.01 / r
+
+
 def test_a_wrapper_name_that_does_not_import_is_one_readable_error():
     assert wrapper_class(None) is None
     assert wrapper_class("agents.wrappers.BallStateObservation") is BallStateObservation
+    assert wrapper_class("agents.wrappers.BallShapeObservation") is BallShapeObservation
     with pytest.raises(ValueError, match="env_wrapper = 'agents.wrappers.Nope'"):
         wrapper_class("agents.wrappers.Nope")
 
