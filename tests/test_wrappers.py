@@ -22,6 +22,18 @@ from agents.wrappers import (
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 
 
+def _into_first_contact(env, raw):
+    """Reset ``env`` (a wrapped env) and ``raw`` with seed 5 and take the same 60 actions of 0.3 (into
+    the first ground contact): their last observations."""
+    obs, _ = env.reset(seed=5)
+    full, _ = raw.reset(seed=5)
+    for _ in range(60):
+        action = np.array([0.3], dtype=np.float32)
+        obs, *_ = env.step(action)
+        full, *_ = raw.step(action)
+    return obs, full
+
+
 def test_ball_state_observation_refuses_another_env():
     with pytest.raises(TypeError, match="not an InflatedBall env"):
         BallStateObservation(gym.make("CartPole-v1"))
@@ -33,12 +45,7 @@ def test_ball_state_keeps_the_body_fields_and_the_total_ground_force(mode):
     env = BallStateObservation(gym.make("InflatedBall-v3", action_mode=mode))
     s = raw.unwrapped.observation_structure
     assert env.observation_space.shape == ((9,) if mode == "pressure" else (12,))
-    obs, _ = env.reset(seed=5)
-    full, _ = raw.reset(seed=5)
-    for _ in range(60):  # into the first contact
-        action = np.array([0.3], dtype=np.float32)
-        obs, *_ = env.step(action)
-        full, *_ = raw.step(action)
+    obs, full = _into_first_contact(env, raw)
     assert env.observation_space.contains(obs)
     assert obs[0:2] == pytest.approx(full[s["centre_of_mass_position"]])
     assert obs[2:4] == pytest.approx(full[s["centre_of_mass_velocity"]])
@@ -78,12 +85,7 @@ def test_ball_shape_adds_the_ring_modes_to_the_ball_state(mode):
     body = BallStateObservation(gym.make("InflatedBall-v3", action_mode=mode))
     n_shape = 2 * (1 + 2 * SHAPE_MODES)
     assert env.observation_space.shape == (body.observation_space.shape[0] + n_shape,)
-    obs, _ = env.reset(seed=5)
-    full, _ = raw.reset(seed=5)
-    for _ in range(60):  # into the first contact
-        action = np.array([0.3], dtype=np.float32)
-        obs, *_ = env.step(action)
-        full, *_ = raw.step(action)
+    obs, full = _into_first_contact(env, raw)
     assert env.observation_space.contains(obs)
     assert obs[:-n_shape] == pytest.approx(body.observation(full))
     assert obs[-n_shape:] == pytest.approx(env.shape_modes(full), abs=1e-6)

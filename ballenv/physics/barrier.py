@@ -60,7 +60,6 @@ CCD_SAFETY = 0.8  # a correction that would make a node meet an edge is cut to t
 BAND_REACH = 4  # node blocks within this many zig-zag positions fit the band (linalg.BAND_HALF_WIDTH)
 PAIRS_PER_NODE = 16  # room for candidate pairs
 STOP_GAP = 0.1  # the start energy alone cannot push a pair closer than this fraction of dhat
-STOP_BETA = -((STOP_GAP**2 - 1.0) ** 2) * math.log(STOP_GAP**2)  # beta(STOP_GAP^2)
 
 
 # ----------------------------------------------------------------------------- the potential
@@ -72,6 +71,9 @@ def beta(y):
     if not y > 0.0:
         return math.inf
     return -(y - 1.0) * (y - 1.0) * math.log(y)
+
+
+BETA_AT_STOP_GAP = beta.py_func(STOP_GAP**2)  # the potential (per kappa dhat^2) at STOP_GAP dhat
 
 
 @kernel(inline="always")
@@ -92,8 +94,9 @@ def beta_curvature(y):
 
 @kernel(inline="always")
 def stiffness(model, r):
-    """``kappa`` (N/m) of ring ``r``: ``max(EA / l_0, K_0 / (dhat^2 STOP_BETA))`` (module doc)."""
-    return max(model.ea[r] / model.rest_len[r], model.start_energy[r] / (model.thickness[r] ** 2 * STOP_BETA))
+    """``kappa`` (N/m) of ring ``r``: ``max(EA / l_0, K_0 / (dhat^2 BETA_AT_STOP_GAP))`` (module doc)."""
+    stop = model.start_energy[r] / (model.thickness[r] ** 2 * BETA_AT_STOP_GAP)
+    return max(model.ea[r] / model.rest_len[r], stop)
 
 
 @kernel(inline="always")

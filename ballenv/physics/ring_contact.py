@@ -35,7 +35,7 @@ import math
 from typing import TYPE_CHECKING
 
 from .barrier import (
-    STOP_BETA,
+    BETA_AT_STOP_GAP,
     beta,
     beta_curvature,
     beta_slope,
@@ -72,7 +72,7 @@ def pair_stiffness(model, a, b):
     or the stiffness that stops their start energies (module doc), whichever is larger."""
     edge = min(model.ea[a] / model.rest_len[a], model.ea[b] / model.rest_len[b])
     reach = pair_reach(model, a, b)
-    return max(edge, (model.start_energy[a] + model.start_energy[b]) / (reach * reach * STOP_BETA))
+    return max(edge, (model.start_energy[a] + model.start_energy[b]) / (reach * reach * BETA_AT_STOP_GAP))
 
 
 @kernel(inline="always")

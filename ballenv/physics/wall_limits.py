@@ -53,20 +53,20 @@ FOLD_U = 1.0 + math.cos(FOLD_ON)  # u_on
 COLLAPSE_ON = 0.25  # edge length (fraction of l0) below which the collapse limit acts
 SHRINK_FLOOR = 0.1  # a motion may shrink an edge to this fraction of its length, no further
 STOP_Y = 0.1  # the start energy alone cannot push y = u / u_on or L^2 / s^2 below this
-STOP_BETA = -((STOP_Y - 1.0) ** 2) * math.log(STOP_Y)  # beta(STOP_Y)
+BETA_AT_STOP_Y = beta.py_func(STOP_Y)  # the limits' potential (per stiffness) at STOP_Y
 
 
 @kernel(inline="always")
 def fold_stiffness(ea, rest_len, energy):
     """``k_f = max(2 u_on EA l0, K_0 / beta(STOP_Y))`` (J) for start energy ``K_0 = energy`` (J)."""
-    return max(2.0 * FOLD_U * ea * rest_len, energy / STOP_BETA)
+    return max(2.0 * FOLD_U * ea * rest_len, energy / BETA_AT_STOP_Y)
 
 
 @kernel(inline="always")
 def collapse_stiffness(ea, rest_len, energy):
     """``k_c = max(EA s^2 / l0, K_0 / beta(STOP_Y))`` (J), ``s = COLLAPSE_ON l0``, for start energy
     ``K_0 = energy`` (J)."""
-    return max(ea * COLLAPSE_ON * COLLAPSE_ON * rest_len, energy / STOP_BETA)
+    return max(ea * COLLAPSE_ON * COLLAPSE_ON * rest_len, energy / BETA_AT_STOP_Y)
 
 
 @kernel(inline="always")

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from ballenv.physics import Ground, Ring, Scene, simulate
-from ballenv.physics.barrier import STOP_BETA
+from ballenv.physics.barrier import BETA_AT_STOP_GAP
 from ballenv.physics.collision import rings_intrude
 from ballenv.physics.model import build_collision_workspace, build_model, build_ring_contact_workspace
 from ballenv.physics.newton import COUPLED
@@ -231,7 +231,7 @@ def test_the_pair_stiffness_spends_both_rings_start_energy():
     )
     energy = thrown.start_energy.sum()
     reach = soft.thickness + stiff.thickness
-    assert pair_stiffness(thrown, 0, 1) == pytest.approx(energy / (reach**2 * STOP_BETA), rel=1e-12)
+    assert pair_stiffness(thrown, 0, 1) == pytest.approx(energy / (reach**2 * BETA_AT_STOP_GAP), rel=1e-12)
     assert pair_stiffness(thrown, 1, 0) == pair_stiffness(thrown, 0, 1)
 
 
