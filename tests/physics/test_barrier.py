@@ -302,62 +302,42 @@ def test_the_barrier_is_stiff_enough_to_spend_the_rings_start_energy():
     assert stiffness(thrown, 0) * ring.thickness**2 * beta(STOP_GAP**2) == pytest.approx(k0, rel=1e-12)
 
 
-def _soak_scene(index):
-    """Two thin walls thrown fast, from the soak (seed 0), and their end times."""
-    if index == 392:  # h/R = 0.006, 30 m/s and 33 rad/s onto flat ground
-        ring = Ring(
-            radius=0.2251346740756372,
-            n_nodes=64,
-            youngs_modulus=458156.2762226351,
-            thickness=0.0013643996781591162,
-            width=0.09523869405771865,
-            density=1031.5075085367903,
-            pressure=519.9281373067845,
-            position=(0.0, 0.5699005690151531),
-            velocity=(13.731044865271038, -27.050777403030427),
-            angular_velocity=33.398045121902356,
-        )
-        return Scene(
-            rings=[ring],
-            grounds=[Ground(friction=1.4909735440943468)],
-            contact="predictor_corrector",
-            gravity=12.717321730575042,
-            damping=0.0,
-            rho_infinity=0.8085577370208539,
-            dt=0.00016664823933942004,
-            adaptive=True,
-            atmospheric_pressure=0.0,
-            gas_exponent=1.4,
-        ), 0.10049042430412317
-    # 1103: h/R = 0.008, empty, 28 m/s and 49 rad/s onto an 8 degree slope
-    ring = Ring(
-        radius=0.2727413811620114,
-        n_nodes=32,
-        youngs_modulus=222478.60937027074,
-        thickness=0.002251771827540602,
-        width=0.058159962633964904,
-        density=262.5472196851116,
-        pressure=None,
-        position=(-0.03857997180564954, 0.27392126651429904),
-        velocity=(7.750873881583246, -27.2387550442769),
-        angular_velocity=48.91430368302153,
-    )
-    return Scene(rings=[ring], grounds=[Ground(angle=0.13992292273830773, friction=1.1276668678395967)],
-                 contact="predictor_corrector", gravity=5.332680929239819, damping=50.0,
-                 rho_infinity=0.9468670816202109, dt=0.004777778224637557, adaptive=True,
-                 atmospheric_pressure=0.0, gas_exponent=1.0), 0.06485330018586018  # fmt: skip
+# Two thin walls thrown fast, from the soak (seed 0): scene 392, h/R = 0.006 at 30 m/s and 33 rad/s
+# onto flat ground, and 1103, h/R = 0.008 and empty at 28 m/s and 49 rad/s onto an 8 degree slope.
+THIN_FAST_392 = Scene(
+    rings=[Ring(radius=0.2251346740756372, n_nodes=64, youngs_modulus=458156.2762226351,
+                thickness=0.0013643996781591162, width=0.09523869405771865, density=1031.5075085367903,
+                pressure=519.9281373067845, position=(0.0, 0.5699005690151531),
+                velocity=(13.731044865271038, -27.050777403030427), angular_velocity=33.398045121902356)],
+    grounds=[Ground(friction=1.4909735440943468)], contact="predictor_corrector", gravity=12.717321730575042,
+    damping=0.0, rho_infinity=0.8085577370208539, dt=0.00016664823933942004, adaptive=True,
+    atmospheric_pressure=0.0, gas_exponent=1.4,
+)  # fmt: skip
+THIN_FAST_1103 = Scene(
+    rings=[Ring(radius=0.2727413811620114, n_nodes=32, youngs_modulus=222478.60937027074,
+                thickness=0.002251771827540602, width=0.058159962633964904, density=262.5472196851116,
+                pressure=None, position=(-0.03857997180564954, 0.27392126651429904),
+                velocity=(7.750873881583246, -27.2387550442769), angular_velocity=48.91430368302153)],
+    grounds=[Ground(angle=0.13992292273830773, friction=1.1276668678395967)], contact="predictor_corrector",
+    gravity=5.332680929239819, damping=50.0, rho_infinity=0.9468670816202109, dt=0.004777778224637557,
+    adaptive=True, atmospheric_pressure=0.0, gas_exponent=1.0,
+)  # fmt: skip
 
 
 @pytest.mark.parametrize(
-    ("index", "stop"), [(392, "a ring's wall crossed itself"), (1103, "the step gained energy")]
+    ("scene", "t_end", "stop"),
+    [
+        (THIN_FAST_392, 0.10049042430412317, "a ring's wall crossed itself"),
+        (THIN_FAST_1103, 0.06485330018586018, "the step gained energy"),
+    ],
+    ids=["392", "1103"],
 )
-def test_thin_walls_thrown_fast_complete_with_the_barriers_sized_to_their_energy(index, stop):
+def test_thin_walls_thrown_fast_complete_with_the_barriers_sized_to_their_energy(scene, t_end, stop):
     """With the edges' stiffness alone (the same start given as x0, v0 to a scene whose rings are at
     rest) these runs stopped at dt_min: in 392 a node was pushed to 1e-5 of the wall thickness from
     an edge, and round-off decided whether a 1 ns step crossed it; in 1103 a fold past 150 degrees.
     With the barrier and the wall limits sized to the start energy they reach their end, every
     invariant held (no crossing, nothing below the ground, no energy made)."""
-    scene, t_end = _soak_scene(index)
     x0, v0 = initial_state(scene)
     at_rest = replace(
         scene, rings=[replace(r, velocity=(0.0, 0.0), angular_velocity=0.0) for r in scene.rings]
