@@ -22,6 +22,7 @@ import os
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import argparse  # noqa: E402
+import dataclasses  # noqa: E402
 import json  # noqa: E402
 import math  # noqa: E402
 import pathlib  # noqa: E402
@@ -30,7 +31,7 @@ import time  # noqa: E402
 
 from ball_family import BALLS, ball_scene, first_apex, gas_to_bending, reference_apex  # noqa: E402
 
-from ballenv.physics import SimulationError  # noqa: E402
+from ballenv.physics import Ground, Simulation, SimulationError, simulate  # noqa: E402
 from ballenv.physics.presets import FIDELITY_PRESETS, with_fidelity  # noqa: E402
 
 RESULTS = pathlib.Path(__file__).parent / "results"
@@ -38,17 +39,24 @@ REFERENCES = RESULTS / "accuracy_references.json"
 TOLERANCES = (3e-2, 1e-2, 3e-3, 1e-3)
 CONTROLS = ("impulse", "doubling")  # Scene.contact_error
 NUMERICS = dict(adaptive=True, dt=1e-2, rho_infinity=0.9)
+SWEEP_NODES = 64  # node count of the rtol sweep
+FORMER_DEFAULT = dict(adaptive=False, dt=1e-4)  # Scene's step before it was error-controlled
+REST_SECONDS = 30.0  # s: the ball at rest of the default's table
+REFERENCE_NODES = sorted({SWEEP_NODES} | {p["n_nodes"] for p in FIDELITY_PRESETS.values()})
 
 
 def references(recompute=False):
-    """ball -> {"apex": reference first apex (m), "uncertainty": relative change at twice its tolerance}."""
+    """node count (str) -> ball -> {"apex": reference first apex (m), "uncertainty": relative change at
+    twice its tolerance}, for the node counts of the sweep and of the presets."""
     if REFERENCES.exists() and not recompute:
         return json.loads(REFERENCES.read_text())
     refs = {}
-    for name in BALLS:
-        fine, uncertainty = reference_apex(name)
-        refs[name] = {"apex": fine, "uncertainty": uncertainty}
-        print(f"reference {name}: {fine:.6f} m (+- {refs[name]['uncertainty']:.1e})", flush=True)
+    for n_nodes in REFERENCE_NODES:
+        refs[str(n_nodes)] = by_ball = {}
+        for name in BALLS:
+            fine, uncertainty = reference_apex(name, n_nodes=n_nodes)
+            by_ball[name] = {"apex": fine, "uncertainty": uncertainty}
+            print(f"reference {name}, N = {n_nodes}: {fine:.6f} m (+- {uncertainty:.1e})", flush=True)
     REFERENCES.write_text(json.dumps(refs, indent=1) + "\n")
     return refs
 
@@ -75,27 +83,36 @@ def sweep(refs, tolerances, progress=print):
     """ball -> {"<control> rtol=x": run, preset name: run}."""
     runs = {}
     for name in BALLS:
-        ref = refs[name]["apex"]
+        ref = refs[str(SWEEP_NODES)][name]["apex"]
         runs[name] = {}
         for control in CONTROLS:
             for rtol in tolerances:
-                scene = ball_scene(name, rtol=rtol, contact_error=control, **NUMERICS)
+                scene = ball_scene(name, SWEEP_NODES, rtol=rtol, contact_error=control, **NUMERICS)
                 runs[name][f"{control} rtol={rtol:g}"] = measure(name, scene, ref)
-        for preset in FIDELITY_PRESETS:  # node count as the preset says; reference at N = 64
-            runs[name][preset] = measure(name, with_fidelity(ball_scene(name), preset), ref)
+        for preset, numerics in FIDELITY_PRESETS.items():  # against the reference at its node count
+            preset_ref = refs[str(numerics["n_nodes"])][name]["apex"]
+            runs[name][preset] = measure(name, with_fidelity(ball_scene(name), preset), preset_ref)
+        runs[name]["default"] = measure(name, ball_scene(name, SWEEP_NODES), ref)
+        runs[name]["former default"] = measure(name, ball_scene(name, SWEEP_NODES, **FORMER_DEFAULT), ref, 1)
         progress(f"{name}: " + ", ".join(f"{k} {v['error']:.1e}" for k, v in runs[name].items()))
     return runs
 
 
 def report(refs, runs, tolerances):
     """The markdown of results/accuracy.md."""
+    lines = ["# Accuracy you ask for: achieved first-apex error per requested `rtol`", ""]
+    tables = sweep_table(refs, runs, tolerances) + preset_table(runs) + node_table(refs) + default_table(runs)
+    return "\n".join(lines + tables) + "\n"
+
+
+def sweep_table(refs, runs, tolerances):
+    """Per ball and contact control: error, err/rtol, wall and steps per tolerance."""
+    sweep_refs = refs[str(SWEEP_NODES)]
     lines = [
-        "# Accuracy you ask for: achieved first-apex error per requested `rtol`",
-        "",
         "`python benchmarks/accuracy.py` (balls: `benchmarks/ball_family.py`; generalized-alpha, "
-        "rho_inf 0.9, adaptive, largest step 10 ms, N = 64). Error: first-apex height relative to the "
-        "ball's converged reference; `err/rtol`: achieved over requested; monotone: the error fell at "
-        "every tightening of rtol. Control: `Scene.contact_error`, impulse (the contact impulse at most "
+        f"rho_inf 0.9, adaptive, largest step 10 ms, N = {SWEEP_NODES}). Error: first-apex height relative "
+        "to the ball's converged reference; `err/rtol`: achieved over requested; monotone: the error fell "
+        "at every tightening of rtol. Control: `Scene.contact_error`, impulse (the contact impulse at most "
         "rtol M sqrt(g R), the default) or doubling (the contact errors of "
         "`ballenv/physics/contact_error.py`).",
         "",
@@ -113,9 +130,10 @@ def report(refs, runs, tolerances):
                 ratios[control].append(r["error"] / t)
                 cells.append(f"{r['error']:.1e} ({r['error'] / t:.2f}), {r['wall'] * 1e3:.0f}, {r['steps']}")
             falls = all(b["error"] < a["error"] for a, b in zip(rs, rs[1:], strict=False))
+            ref = sweep_refs[name]
             lines.append(
-                f"| {name} | {control} | {gas_to_bending(name):,.1f} | {refs[name]['apex']:.5f} | "
-                f"{refs[name]['uncertainty']:.0e} | " + " | ".join(cells) + f" | {'yes' if falls else 'no'} |"
+                f"| {name} | {control} | {gas_to_bending(name):,.1f} | {ref['apex']:.5f} | "
+                f"{ref['uncertainty']:.0e} | " + " | ".join(cells) + f" | {'yes' if falls else 'no'} |"
             )
     lines.append("")
     for control, qs in ratios.items():
@@ -125,13 +143,98 @@ def report(refs, runs, tolerances):
             f"- {control}: err/rtol {min(qs):.2f}-{max(qs):.2f}, within 0.3-3 in {inside} of {len(qs)} "
             f"runs; wall time of the {len(qs)} runs {walls:.2f} s."
         )
-    lines += ["", "The fidelity presets (their own node counts; error against the N = 64 reference):", ""]
-    lines += ["| ball | " + " | ".join(f"{p}: err, wall ms" for p in FIDELITY_PRESETS) + " |"]
-    lines += ["|---|" + "---:|" * len(FIDELITY_PRESETS)]
+    return lines
+
+
+def preset_table(runs):
+    """Per ball: each preset's error against the reference at its node count, and its wall time."""
+    lines = [
+        "",
+        "The fidelity presets (`ballenv/physics/presets.py`; each at its own node count, its error against "
+        "the converged run at that node count):",
+        "",
+        "| ball | "
+        + " | ".join(
+            f"{p} (N = {v['n_nodes']}, rtol {v['rtol']:g}): err, wall ms" for p, v in FIDELITY_PRESETS.items()
+        )
+        + " |",
+        "|---|" + "---:|" * len(FIDELITY_PRESETS),
+    ]
     for name in BALLS:
         cells = [f"{runs[name][p]['error']:.1e}, {runs[name][p]['wall'] * 1e3:.0f}" for p in FIDELITY_PRESETS]
         lines.append(f"| {name} | " + " | ".join(cells) + " |")
-    return "\n".join(lines) + "\n"
+    worst = {p: max(runs[n][p]["error"] for n in BALLS) for p in FIDELITY_PRESETS}
+    lines += ["", "| preset | stated bound | worst over the balls | held |", "|---|---:|---:|---|"]
+    for p, v in FIDELITY_PRESETS.items():
+        bound = v["apex_error_bound"]
+        lines.append(f"| {p} | {bound:.1%} | {worst[p]:.2%} | {'yes' if worst[p] <= bound else 'NO'} |")
+    return lines
+
+
+def node_table(refs):
+    """Per ball: the converged first apex at each node count and its change from the next coarser."""
+    counts = [str(n) for n in REFERENCE_NODES]
+    lines = [
+        "",
+        "What the node count costs in accuracy (the polygon's own error, which no step control removes): "
+        "the converged first apex per node count, and its change from the next coarser count.",
+        "",
+        "| ball | " + " | ".join(f"N = {n}: apex (m), change" for n in counts) + " |",
+        "|---|" + "---:|" * len(counts),
+    ]
+    for name in BALLS:
+        apexes = [refs[n][name]["apex"] for n in counts]
+        cells = [f"{apexes[0]:.5f}"]
+        cells += [f"{b:.5f}, {b / a - 1:+.2%}" for a, b in zip(apexes, apexes[1:], strict=False)]
+        lines.append(f"| {name} | " + " | ".join(cells) + " |")
+    return lines
+
+
+def resting_walls():
+    """(wall s of ``REST_SECONDS`` of the env's ball (damping 20 1/s) resting on its floor with Scene's
+    default step, with the former default's fixed 0.1 ms steps)."""
+    rest = dataclasses.replace(ball_scene("env", SWEEP_NODES), grounds=(Ground(friction=0.5),), damping=20.0)
+    x0 = resting_nodes(rest)
+    walls = []
+    for numerics in ({}, FORMER_DEFAULT):
+        scene = dataclasses.replace(rest, **numerics)
+        simulate(scene, 1e-3, x0=x0)  # numba warm
+        walls.append(simulate(scene, REST_SECONDS, x0=x0).stats.wall_time)
+    return tuple(walls)
+
+
+def resting_nodes(scene):
+    """The ring of ``scene`` moved down to rest its lowest node on the floor (nodes, m)."""
+    x = Simulation(scene).state.x[0].copy()
+    x[:, 1] -= x[:, 1].min()
+    return x
+
+
+def default_table(runs):
+    """Scene's default step (adaptive, rtol 0.01) against the former default (fixed 0.1 ms steps)."""
+    at_rest, at_rest_former = resting_walls()
+    lines = [
+        "",
+        '`Scene`\'s default step (adaptive, largest step 10 ms, `rtol` 0.01, `contact_error` "impulse", '
+        "rho_inf 0.9; the sweep's impulse rtol=0.01 run) against the former default (fixed 0.1 ms steps), "
+        f"N = {SWEEP_NODES}:",
+        "",
+        "| ball | default: err, wall ms, steps | fixed 0.1 ms: err, wall ms, steps |",
+        "|---|---:|---:|",
+    ]
+    for name in BALLS:
+        cells = [runs[name][k] for k in ("default", "former default")]
+        lines.append(
+            f"| {name} | "
+            + " | ".join(f"{r['error']:.1e}, {r['wall'] * 1e3:.0f}, {r['steps']}" for r in cells)
+            + " |"
+        )
+    lines += [
+        "",
+        f"The env's ball at rest on its floor (friction 0.5) for {REST_SECONDS:g} s: {at_rest:.2f} s of wall "
+        f"time with the default step, {at_rest_former:.1f} s with fixed 0.1 ms steps.",
+    ]
+    return lines
 
 
 def plot(runs, tolerances, path):

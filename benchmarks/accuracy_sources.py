@@ -64,7 +64,7 @@ def table(refs, progress=print):
         "|---|---:|---:|---:|---|---|---:|---:|",
     ]
     for name in BALLS:
-        ref = refs[name]["apex"]
+        ref = refs["64"][name]["apex"]
         n_ref = reference_events(name)
         for rtol in TOLERANCES:
             both = run(name, ball_scene(name, rtol=rtol, **NUMERICS), ref)

@@ -87,17 +87,20 @@ def momentum_scale(name):
     return total_mass(ring) * math.sqrt(9.81 * ring.radius)
 
 
-def reference_scene(name, tol=REFERENCE_TOL):
-    """Ball ``name`` with the reference's step control: contact impulse per step at most
-    ``tol M sqrt(g R)`` (N s), steps <= ``REFERENCE_DT``."""
+def reference_scene(name, tol=REFERENCE_TOL, n_nodes=64):
+    """Ball ``name`` of ``n_nodes`` nodes with the reference's step control: contact impulse per step
+    at most ``tol M sqrt(g R)`` (N s, error control off), steps <= ``REFERENCE_DT``."""
     impulse_tol = tol * momentum_scale(name)
-    return ball_scene(name, adaptive=True, dt=REFERENCE_DT, impulse_tol=impulse_tol, rho_infinity=0.9)
+    return ball_scene(
+        name, n_nodes, adaptive=True, dt=REFERENCE_DT, rtol=0.0, impulse_tol=impulse_tol, rho_infinity=0.9
+    )
 
 
-def reference_apex(name, tol=REFERENCE_TOL):
-    """(converged first apex (m), its relative change at twice ``tol``) of ball ``name``."""
-    fine = first_apex(name, reference_scene(name, tol))[0]
-    coarse = first_apex(name, reference_scene(name, 2.0 * tol))[0]
+def reference_apex(name, tol=REFERENCE_TOL, n_nodes=64):
+    """(converged first apex (m), its relative change at twice ``tol``) of ball ``name`` at ``n_nodes``
+    nodes."""
+    fine = first_apex(name, reference_scene(name, tol, n_nodes))[0]
+    coarse = first_apex(name, reference_scene(name, 2.0 * tol, n_nodes))[0]
     return fine, abs(coarse - fine) / fine
 
 

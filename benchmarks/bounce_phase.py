@@ -24,8 +24,8 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 import numpy as np  # noqa: E402
 
 from ballenv.envs.config import BallEnvConfig  # noqa: E402
+from ballenv.envs.numerics import ENV_FIDELITIES  # noqa: E402
 from ballenv.physics import simulate  # noqa: E402
-from ballenv.physics.presets import FIDELITY_PRESETS  # noqa: E402
 from ballenv.physics.ring import initial_nodes  # noqa: E402
 
 RESULTS = pathlib.Path(__file__).parent / "results"
@@ -61,7 +61,7 @@ def main() -> None:
         "| preset | N | launch | rise mean (m) | std / mean | (max - min) / mean |",
         "|---|---:|---|---:|---:|---:|",
     ]
-    for fidelity, preset in FIDELITY_PRESETS.items():
+    for fidelity, preset in ENV_FIDELITIES.items():
         for launch, (height, velocity) in LAUNCHES.items():
             r = rises(fidelity, height, velocity)
             spread = (r.max() - r.min()) / r.mean()

@@ -34,6 +34,7 @@ from step_cost import compile_times  # noqa: E402
 
 import ballenv  # noqa: E402, F401
 from ballenv.envs import ENV_ID  # noqa: E402
+from ballenv.envs.numerics import ENV_FIDELITIES  # noqa: E402
 from ballenv.physics.assembly import ring_force, ring_jacobian  # noqa: E402
 from ballenv.physics.integrator import coefficients  # noqa: E402
 from ballenv.physics.layout import (  # noqa: E402
@@ -47,7 +48,6 @@ from ballenv.physics.layout import (  # noqa: E402
 )
 from ballenv.physics.linalg import solve_band_low_rank  # noqa: E402
 from ballenv.physics.model import build_workspace  # noqa: E402
-from ballenv.physics.presets import FIDELITY_PRESETS  # noqa: E402
 
 RESULTS = pathlib.Path(__file__).parent / "results"
 _COLD_START_SNIPPET = f"""
@@ -150,7 +150,7 @@ def profile(preset, mode):
     action = np.zeros(1, np.float32)
     python = best_time(lambda n: [env.step(action) for _ in range(n)], 3000) - dispatch
     batch.step = physics_step
-    residual, jacobian, solve = kernel_costs(batch, FIDELITY_PRESETS[preset]["dt"] / 2)
+    residual, jacobian, solve = kernel_costs(batch, ENV_FIDELITIES[preset]["dt"] / 2)
     newton = counts[COUNT_NEWTON]
     # an iteration evaluates one residual and solves once; each solve also evaluates the residual of
     # its result, so residuals ~ iterations + one per step
@@ -215,7 +215,7 @@ def table(rows):
 
 
 def main(argv=None):
-    presets = (argv or sys.argv[1:]) or tuple(FIDELITY_PRESETS)
+    presets = (argv or sys.argv[1:]) or tuple(ENV_FIDELITIES)
     rows = [profile(preset, mode) for preset in presets for mode in MODES]
     reset, first_step, cached_step = compile_times(_COLD_START_SNIPPET)
     text = table(rows) + (

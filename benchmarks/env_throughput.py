@@ -28,12 +28,12 @@ from tqdm.auto import tqdm  # noqa: E402
 
 import ballenv  # noqa: E402, F401
 from ballenv.controllers import PaddleDribble, PressurePump  # noqa: E402
+from ballenv.envs.numerics import ENV_FIDELITIES, with_env_fidelity  # noqa: E402
 from ballenv.physics import Ground, Ring, Scene, simulate  # noqa: E402
-from ballenv.physics.presets import FIDELITY_PRESETS, with_fidelity  # noqa: E402
 from ballenv.physics.ring import total_mass  # noqa: E402
 
 RESULTS = pathlib.Path(__file__).parent / "results"
-PRESETS = tuple(FIDELITY_PRESETS)
+PRESETS = tuple(ENV_FIDELITIES)
 MODES = ("pressure", "paddle")
 SINGLE_STEPS = 2000
 VECTOR_SIZES = (1, 8, 64)
@@ -139,14 +139,14 @@ def drop_scene():
 def preset_errors():
     """{preset: (first apex m, relative error, wall s)} and the reference apex."""
     base = drop_scene()
-    reference_scene = with_fidelity(base, "accurate")
+    reference_scene = with_env_fidelity(base, "accurate")
     reference_scene = reference_scene.__class__(
         **{**reference_scene.__dict__, "dt": 1e-3, "impulse_tol": 1e-4, "newton_tol": 1e-10}
     )
     reference = simulate(reference_scene, 0.9).apexes()[0, 1]
     out = {}
     for preset in PRESETS:
-        sc = with_fidelity(base, preset)
+        sc = with_env_fidelity(base, preset)
         simulate(sc, 0.05)
         walls = []
         for _ in range(3):
@@ -183,7 +183,7 @@ def main():
         "|---|---:|---:|---:|---:|",
     ]
     for preset, (apex, err, wall) in errors.items():
-        nodes = FIDELITY_PRESETS[preset]["n_nodes"]
+        nodes = ENV_FIDELITIES[preset]["n_nodes"]
         lines.append(f"| {preset} | {nodes} | {apex:.5f} | {err:.2%} | {wall * 1e3:.1f} |")
     text = "\n".join(lines) + "\n"
     (RESULTS / "env_throughput.md").write_text(text)

@@ -137,6 +137,16 @@ BALLENV_SETTINGS = [
         for rtol in (3e-2, 1e-2)
         for rho in (0.5, 0.3)
     ],
+    # the same with a looser Newton tolerance, or a longer largest step (the flight's steps)
+    (
+        "GA adaptive dt<=1e-2 rtol=3e-2, rho_inf=0.3, newton_tol=1e-6",
+        dict(adaptive=True, dt=1e-2, rtol=3e-2, rho_infinity=0.3, newton_tol=1e-6),
+    ),
+    (
+        "GA adaptive dt<=2e-2 rtol=3e-2, rho_inf=0.3",
+        dict(adaptive=True, dt=2e-2, rtol=3e-2, rho_infinity=0.3),
+    ),
+    ("Scene() default (adaptive dt<=1e-2 rtol=1e-2)", dict()),
     *[(f"preset {name} (N={p['n_nodes']})", dict(fidelity=name)) for name, p in FIDELITY_PRESETS.items()],
 ]
 QUICK_BALLENV = ("GA fixed dt=2^-11", "GA adaptive dt<=1e-3 tol=1e-4", "preset balanced (N=64)")

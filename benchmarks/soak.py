@@ -1,6 +1,7 @@
 """Soak run of the stability suite (``tests/stability``): thousands of random scenes and env episodes, seeded.
 
     python benchmarks/soak.py [--scenes 2000] [--episodes 400] [--seed 0] [--ray local|auto|ADDRESS]
+                              [--rtol RTOL --out benchmarks/results/soak_rtol.md]
     # prints the table, writes benchmarks/results/soak.md
 
 Scenes: drawn like ``tests/stability/test_random.py``'s valid scenes (the hard cases' ranges): one
@@ -8,7 +9,8 @@ or two rings of radius 0.05-0.3 m, N 8-256, E 0.1 MPa-1 GPa (log-uniform), h/R 0
 pressure none or 0-40 % of the wall's bound (at most 10 bar), released 1 mm-0.5 m above a floor or a
 slope of up to 75 degrees (friction 0-2) at up to 30 m/s per component and 50 rad/s, gravity
 0-20 m/s^2, damping 0/5/50 1/s, either contact method and integrator, rho_inf 0-1, adaptive or
-fixed steps of 1e-4-1e-2 s, 0.02-0.15 s simulated. Each run is audited
+fixed steps of 1e-4-1e-2 s (adaptive: the contact impulse per step at most 5e-3 N s, or with
+``--rtol`` the error control ``Scene.rtol``), 0.02-0.15 s simulated. Each run is audited
 (``tests/stability/invariants.py``): non-finite states, tunnelling (a node more than 1e-6 m below a
 ground, or inside another ring), energy growth (total energy above its start value by more than
 1e-9 of the start's sum of |parts| plus the energy the collision impulses' push-out created), and
@@ -57,13 +59,14 @@ from tests.stability.invariants import (  # noqa: E402
 )
 
 RESULTS = ROOT / "benchmarks" / "results"
-REASONS = ("newton", "energy", "intrusion", "self_intersection", "impulse")
+REASONS = ("newton", "energy", "intrusion", "self_intersection", "impulse", "error")
 FAILURE_KEYS = {
     "a ring's wall crossed itself": "dt_min: wall crossed itself",
     "Newton's iteration did not converge": "dt_min: Newton did not converge",
     "the step gained energy": "dt_min: step gained energy",
     "a node of one ring ended inside another ring": "dt_min: ring intrusion",
     "contact impulse per step stayed above": "impulse above impulse_tol at dt_min",
+    "contact impulse per step or the local error stayed above": "impulse or local error above rtol at dt_min",
 }
 
 
@@ -106,6 +109,7 @@ def random_scene(rng):
         atmospheric_pressure=float(rng.choice([0.0, 101325.0])),
         adaptive=bool(rng.random() < 0.7),
         dt=log_uniform(rng, 1e-4, 1e-2),
+        impulse_tol=5e-3,  # adaptive steps follow the contact impulse, unless draw_scenes is given rtol
     )
     return scene, rng.uniform(0.02, 0.15)
 
@@ -163,17 +167,21 @@ def scene_times(outcomes, cores=(1, 2, 64)):
     ]
 
 
-def draw_scenes(count, seed):
-    """The soak's ``count`` random ``(scene, t_end)`` tasks of ``seed``, drawn in order."""
+def draw_scenes(count, seed, rtol=None):
+    """The soak's ``count`` random ``(scene, t_end)`` tasks of ``seed``, drawn in order; with ``rtol``
+    the adaptive ones under error control (``Scene.rtol``) instead of the contact impulse bound."""
     rng = np.random.default_rng(seed)
-    return [random_scene(rng) for _ in range(count)]
+    tasks = [random_scene(rng) for _ in range(count)]
+    if rtol is None:
+        return tasks
+    return [(replace(s, impulse_tol=None, rtol=rtol) if s.adaptive else s, t_end) for s, t_end in tasks]
 
 
-def soak_scenes(count, seed, cluster=None):
+def soak_scenes(count, seed, cluster=None, rtol=None):
     """Run the soak's scenes (in this process, or as Ray tasks on ``cluster``: ballenv.cluster) and
     tally them in scene order, so the tallies do not depend on where or in which order they ran:
     ``(SceneTallies, the tasks lost with their worker, the report's lines on the run times)``."""
-    tasks = draw_scenes(count, seed)
+    tasks = draw_scenes(count, seed, rtol)
     outcomes, lost = collect(
         run_tasks(
             run_scene, tasks, cluster, desc="scenes", warm=partial(warm_simulator, audit), paths=[str(ROOT)]
@@ -307,9 +315,12 @@ def main():
         help="run the scenes as Ray tasks: 'local' (a cluster on this machine), 'auto' or an address",
     )
     parser.add_argument("--out", type=pathlib.Path, default=RESULTS / "soak.md", help="the report's path")
+    parser.add_argument(
+        "--rtol", type=float, default=None, help="the adaptive scenes under error control (Scene.rtol)"
+    )
     args = parser.parse_args()
     start = time.perf_counter()
-    tallies, lost, times = soak_scenes(args.scenes, args.seed, check_cluster(args.cluster))
+    tallies, lost, times = soak_scenes(args.scenes, args.seed, check_cluster(args.cluster), args.rtol)
     tally, rejected, ends, growth, removed, worst, crashes, stops, tunnelled = tallies
     scene_time = time.perf_counter() - start
     episodes = soak_episodes(args.episodes, args.seed + 1)
@@ -325,6 +336,12 @@ def main():
         f"{wall:.0f} s ({scene_time:.0f} s scenes"
         + (f" as Ray tasks on {args.cluster}" if args.cluster else "")
         + "), numba warm from the on-disk cache."
+        + (
+            f" Adaptive scenes under error control, Scene.rtol = {args.rtol:g} (contact_error "
+            '"impulse"), instead of impulse_tol = 5e-3 N s.'
+            if args.rtol is not None
+            else ""
+        )
         + (f" Scenes lost with their Ray worker: {', '.join(str(t.index) for t in lost)}." if lost else ""),
         "",
         "## Random scenes",

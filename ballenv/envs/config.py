@@ -14,11 +14,11 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..physics import Ground, Ring, Scene
 from ..physics.layout import STATUS_IMPULSE_AT_DT_MIN, STATUS_STEP_TOO_SMALL
-from ..physics.presets import FIDELITY_PRESETS, with_fidelity
 from ..physics.ring import burst_pressure, inflation_ratio_of
 from ..physics.scene import check_choice, check_real
 from . import observation
 from .batch import END_FAILURE, MODE_PADDLE, MODE_PRESSURE, Task
+from .numerics import ENV_FIDELITIES, with_env_fidelity
 
 ACTION_MODES = {"pressure": MODE_PRESSURE, "paddle": MODE_PADDLE}
 FAILURES = {
@@ -62,7 +62,7 @@ class BallEnvConfig:
         o = "InflatedBall-v3"
         s = object.__setattr__
         check_choice(o, "action_mode", self.action_mode, tuple(ACTION_MODES))
-        check_choice(o, "fidelity", self.fidelity, tuple(FIDELITY_PRESETS))
+        check_choice(o, "fidelity", self.fidelity, tuple(ENV_FIDELITIES))
         s(
             self,
             "control_frequency",
@@ -119,7 +119,7 @@ class BallEnvConfig:
 
     @property
     def n_nodes(self) -> int:
-        return FIDELITY_PRESETS[self.fidelity]["n_nodes"]
+        return ENV_FIDELITIES[self.fidelity]["n_nodes"]
 
     def ring(self, pressure: float | None) -> Ring:
         """The ball as a physics Ring holding gas ``pressure`` (Pa) at rest."""
@@ -137,7 +137,7 @@ class BallEnvConfig:
             damping=self.damping,
             self_intersection="reject",  # the env's dynamics: no self-contact barrier
         )
-        return with_fidelity(base, self.fidelity)
+        return with_env_fidelity(base, self.fidelity)
 
     def task_settings(self) -> dict[str, float]:
         """The scalar fields of ``batch.Task``."""

@@ -105,7 +105,7 @@ class InflatedBallEnv(Env[NDArray[np.float32], NDArray[np.float32]], EzPickle):
     | Parameter                   | Type  | Default        | Description |
     |-----------------------------|-------|----------------|-------------|
     | action_mode                 | str   | "pressure"     | "pressure" or "paddle" |
-    | fidelity                    | str   | "fast"         | numerical preset: "fast", "balanced", "accurate" (README) |
+    | fidelity                    | str   | "fast"         | node count and step control: "fast", "balanced", "accurate" (`ballenv.envs.numerics`) |
     | control_frequency           | float | 100.0          | control steps per second (Hz) |
     | target_height_range         | tuple | (0.5, 1.0)     | target apex height of the centre (m) |
     | start_height_range          | tuple | (0.6, 1.2)     | initial height of the centre (m) |

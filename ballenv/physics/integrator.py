@@ -78,7 +78,7 @@ def build_solver(scene):
         dt_min=float(scene.dt_min),
         adaptive=bool(scene.adaptive),
         growth=STEP_GROWTH,
-        rtol=float(scene.rtol) if scene.adaptive else 0.0,
+        rtol=float(scene.step_rtol) if scene.adaptive else 0.0,
         atol=float(scene.atol),
     )
 

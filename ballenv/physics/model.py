@@ -321,17 +321,18 @@ def _fill_rest_energy(model, rings):
 
 def impulse_bounds(scene):
     """(R,) the adaptive step's bound on a ring's contact impulse per step (N s): ``Scene.impulse_tol``,
-    or with error control (``Scene.rtol`` > 0) ``rtol M sqrt(g R)``, relative to the momentum of the
+    or with error control (``Scene.step_rtol`` > 0) ``rtol M sqrt(g R)``, relative to the momentum of the
     ring (mass ``M``, kg; radius ``R``, m) falling its own radius (``g`` = 9.81 m/s^2 without
     gravity); with ``Scene.contact_error = "doubling"`` ``LIFTOFF_IMPULSE sqrt(rtol) M sqrt(g R)``:
     there the contact errors of :mod:`.contact_error` control the step in contact, and this bound
     only what they cannot see (a node released a step early)."""
-    if scene.rtol == 0.0:
-        return np.full(len(scene.rings), float(scene.impulse_tol))
+    rtol = scene.step_rtol
+    if rtol == 0.0:
+        return np.full(len(scene.rings), float(scene.impulse_tol or 0.0))  # unused by fixed steps without it
     g = float(np.hypot(*scene.gravity_vector)) or SCALE_GRAVITY
-    factor = scene.rtol
+    factor = rtol
     if scene.contact_error == "doubling":
-        factor = LIFTOFF_IMPULSE * math.sqrt(scene.rtol)
+        factor = LIFTOFF_IMPULSE * math.sqrt(rtol)
     return np.array([factor * ring_geometry.total_mass(r) * math.sqrt(g * r.radius) for r in scene.rings])
 
 

@@ -1,30 +1,35 @@
-"""Fidelity presets: named accuracy-for-cost settings of the numerical method.
+"""Fidelity presets: named accuracy-for-cost settings of the numerical method, each defined by the
+accuracy it asks for.
 
 Each preset sets the node count of every ring and the step control of the scene; the physics
 (material, pressure, effects) is untouched. All are generalized-alpha with ``rho_infinity = 0.3``
-and the step adapted to the contact impulse (``Scene.adaptive``):
+whose adaptive step keeps the error within the relative tolerance ``rtol`` (``Scene.rtol``: the
+integrator's local error estimate on the nodes' positions at most ``rtol R``, and the contact
+impulse per step at most ``rtol M sqrt(g R)``, ``M`` the ring's mass and ``R`` its radius):
 
-=========  ======  ===========  ================  ============  ====================  ===========
-preset     nodes   largest dt   impulse_tol       newton_tol    first-apex error      wall, 0.9 s
-=========  ======  ===========  ================  ============  ====================  ===========
-fast       32      0.02 s       0.01 N s          1e-6          1.3 % (bound 5 %)     6-8 ms
-balanced   64      0.01 s       0.002 N s         1e-9          0.34 % (bound 0.5 %)  23-30 ms
-accurate   128     0.005 s      0.0005 N s        1e-10         0.02 % (bound 0.3 %)  113-140 ms
-=========  ======  ===========  ================  ============  ====================  ===========
+=========  ======  =====  ==========  ==========  ====================  ==================  ===========
+preset     nodes   rtol   largest dt  newton_tol  first-apex error      measured worst      wall, 1 s
+=========  ======  =====  ==========  ==========  ====================  ==================  ===========
+fast       32      0.1    0.02 s      1e-6        bound 3 %             1.6 %               4-10 ms
+balanced   64      0.02   0.01 s      1e-9        bound 1 %             0.6 %               21-58 ms
+accurate   128     0.003  0.005 s     1e-10       bound 0.3 %           0.06 %              160-730 ms
+=========  ======  =====  ==========  ==========  ====================  ==================  ===========
 
-Errors and wall times are measured by ``benchmarks/work_precision.py`` on its single-bounce scene
-(the env's ball dropped from 1 m onto flat ground) against a reference at N = 256 whose own
-uncertainty is 0.11 % (doubling N moves it by that much); ``tests/physics/test_presets.py`` checks
-the bounds. The node counts are the env's observation sizes. ``rho_infinity = 0.3`` (the Scene
-default is 0.9) damps the wall's modes above what the step resolves: at the presets' steps (10-20 ms,
-longer than the 8 ms breathing period) the lightly damped 0.9 left them ringing, which cost Newton
-iterations and rejected steps (energy guard, self-crossing), and made the first apex *less*
-accurate (fast 3.2 %, balanced 0.22 %, accurate 0.12 % at 0.9). Measured with
-``benchmarks/env_profile.py`` on random actions, 0.9 -> 0.3: fast 39 -> 8 Newton iterations per
-pressure-mode control step and 49 -> 19 per paddle-mode one; ``rho_infinity = 0`` saves a little
-more (7 and 19) but doubles the restitution error of the bouncing scene. A tighter ``impulse_tol``
-for fast (5e-3 N s) was not taken: violent paddle strikes in the env then end in "impulse above
-impulse_tol at dt_min" simulator failures. Wall times: range over runs of the benchmark.
+The error is that of the step control: the first-apex height of the six balls of
+``benchmarks/ball_family.py`` (3 g to 500 g, gas-to-bending stiffness ratio 1.9 to 7,800, flat
+floor and slope, with and without friction) against a converged run of the same ball at the same
+node count; ``benchmarks/accuracy.py`` measures it (with the wall time of the 1-s drop) and
+``tests/physics/test_presets.py`` checks every preset's bound on every ball. The node count is a
+separate choice with its own error, the polygon's: the converged first apex moves by up to 5 %
+from N = 32 to N = 64 and up to 1.2 % from 64 to 128 (the bending-dominated ball; the table
+``benchmarks/results/accuracy.md`` gives every ball's). ``rho_infinity = 0.3`` (the Scene default
+is 0.9) damps the wall's modes above what the step resolves, which cost Newton iterations and
+rejected steps when left ringing: at N = 64 and the same ``rtol`` the runs take 1.5-2x less wall
+time than with 0.9, and the worst error over the six balls differs by at most 2.7x either way
+(0.85 / 0.26 / 0.33 % against 0.72 / 0.70 / 0.14 % at rtol 0.03 / 0.01 / 0.003).
+
+InflatedBall-v3's ``fidelity`` keyword keeps the settings its dynamics were defined with
+(:mod:`ballenv.envs.numerics`).
 """
 
 import dataclasses
@@ -32,10 +37,12 @@ from typing import Any
 
 from .scene import Scene, check_choice
 
+PRESET_RHO_INFINITY = 0.3  # generalized-alpha's high-frequency damping in every preset
+
 FIDELITY_PRESETS: dict[str, dict[str, Any]] = {
-    "fast": {"n_nodes": 32, "dt": 2e-2, "impulse_tol": 1e-2, "newton_tol": 1e-6, "rho_infinity": 0.3},
-    "balanced": {"n_nodes": 64, "dt": 1e-2, "impulse_tol": 2e-3, "newton_tol": 1e-9, "rho_infinity": 0.3},
-    "accurate": {"n_nodes": 128, "dt": 5e-3, "impulse_tol": 5e-4, "newton_tol": 1e-10, "rho_infinity": 0.3},
+    "fast": {"n_nodes": 32, "rtol": 0.1, "dt": 2e-2, "newton_tol": 1e-6, "apex_error_bound": 0.03},
+    "balanced": {"n_nodes": 64, "rtol": 0.02, "dt": 1e-2, "newton_tol": 1e-9, "apex_error_bound": 0.01},
+    "accurate": {"n_nodes": 128, "rtol": 3e-3, "dt": 5e-3, "newton_tol": 1e-10, "apex_error_bound": 0.003},
 }
 
 
@@ -51,8 +58,9 @@ def with_fidelity(scene: Scene, fidelity: str) -> Scene:
         rings=rings,
         integrator="generalized_alpha",
         adaptive=True,
+        rtol=preset["rtol"],
+        contact_error="impulse",
         dt=preset["dt"],
-        impulse_tol=preset["impulse_tol"],
         newton_tol=preset["newton_tol"],
-        rho_infinity=preset["rho_infinity"],
+        rho_infinity=PRESET_RHO_INFINITY,
     )

@@ -20,6 +20,7 @@ DAMPING_MODES = ("rigid", "centre_of_mass")
 CONTACT_METHODS = ("mass_modification", "predictor_corrector")
 SELF_INTERSECTION = ("barrier", "reject", "ignore")
 CONTACT_ERRORS = ("impulse", "doubling")
+DEFAULT_RTOL = 1e-2  # the adaptive step's relative tolerance when a Scene names neither rtol nor impulse_tol
 
 T = TypeVar("T")
 
@@ -278,6 +279,26 @@ class Drum:
         return self.angular_velocity != 0.0
 
 
+def _check_step_tolerances(scene: "Scene") -> None:
+    """``impulse_tol`` and ``rtol``: each None or in range, and not both asking to control the step."""
+    o, s = "Scene", object.__setattr__
+    if scene.impulse_tol is not None:
+        s(scene, "impulse_tol", check_real(o, "impulse_tol", scene.impulse_tol, 0.0, 10.0, "N s", True))
+    if scene.rtol is not None:
+        s(scene, "rtol", check_real(o, "rtol", scene.rtol, 0.0, 1.0))
+    if scene.impulse_tol is not None and scene.rtol:
+        raise ValueError(
+            f"Scene.impulse_tol = {scene.impulse_tol!r} is invalid with Scene.rtol = {scene.rtol!r}: give "
+            "one of them (rtol > 0 sets its own bound on the contact impulse; rtol = 0 turns error "
+            "control off)"
+        )
+    if scene.adaptive and scene.step_rtol == 0.0 and scene.impulse_tol is None:
+        raise ValueError(
+            "Scene.impulse_tol = None is invalid with Scene.rtol = 0 and adaptive steps: the step then "
+            "follows the contact impulse alone and needs its bound, in (0, 10] N s"
+        )
+
+
 @dataclass(frozen=True)
 class Scene:
     """What to simulate: rings, the effects acting on them, and the numerical method.
@@ -289,17 +310,21 @@ class Scene:
         contact: "mass_modification" (Baraff-Witkin: the contact set is updated inside the Newton
             iteration; the system keeps its size) or "predictor_corrector" (the paper's first
             method: the whole step is recomputed after each change of the contact set).
-        impulse_tol: largest contact impulse per step ``f dt`` (N s) in (0, 10] when ``adaptive``: a
-            ring's total ground reaction over the step, net of the momentum that stops nodes moving
-            into the ground at the step's start (arriving ones, or resting ones a collision impulse
-            pushed; see ``stepper.try_step``); larger steps are rejected and shrunk by the ratio,
-            smaller ones grow by at most x1.25. Not used when ``rtol`` > 0 (which sets its own bound).
-        rtol: error control of the adaptive step, dimensionless in [0, 1]; 0 (default): off, the step
-            follows ``impulse_tol`` alone. Above 0 (with ``adaptive``), every step keeps two measures
-            within it: the local error estimate of the integrator (``local_error.py``), its RMS over a
-            ring's nodes at most ``atol + rtol R`` (m, ``R`` the ring's radius), and the error in
-            contact as ``contact_error`` says, so the same ``rtol`` asks the same relative accuracy
-            of a 3 g ring and a 500 g ball. What it achieves on six balls: ``benchmarks/accuracy.py``.
+        impulse_tol: None (default) or the largest contact impulse per step ``f dt`` (N s) in (0, 10]:
+            given, the adaptive step follows this absolute bound alone (error control off unless
+            ``rtol`` > 0 is given too, which is an error). The impulse is a ring's total ground
+            reaction over the step, net of the momentum that stops nodes moving into the ground at
+            the step's start (arriving ones, or resting ones a collision impulse pushed; see
+            ``stepper.try_step``); larger steps are rejected and shrunk by the ratio, smaller ones
+            grow by at most x1.25.
+        rtol: error control of the adaptive step, dimensionless in [0, 1]; None (default): 0.01
+            (``DEFAULT_RTOL``) unless ``impulse_tol`` is given, then 0 (``step_rtol`` is the value in
+            use). Above 0, every step keeps two measures within it: the local error estimate of the
+            integrator (``local_error.py``), its RMS over a ring's nodes at most ``atol + rtol R``
+            (m, ``R`` the ring's radius), and the error in contact as ``contact_error`` says, so the
+            same ``rtol`` asks the same relative accuracy of a 3 g ring and a 500 g ball. What it
+            achieves on six balls: ``benchmarks/accuracy.py`` (the default's first-apex error
+            0.04-0.7 % on them, in 1/10-1/3 of the wall time of fixed 0.1 ms steps).
         contact_error: how ``rtol`` controls a step with a node on a ground at either end.
             "impulse" (default): the contact impulse (as for ``impulse_tol``) at most
             ``rtol M sqrt(g R)`` (N s, ``M`` the ring's mass: the momentum of the ring falling its own
@@ -321,12 +346,15 @@ class Scene:
         integrator: "generalized_alpha" (second order, default) or "backward_euler" (first order).
         rho_infinity: spectral radius at infinite frequency of generalized-alpha, in [0, 1]
             (1 = no numerical damping, trapezoidal rule; 0 = strongest high-frequency damping).
-        dt: time step (s) in (0, 1]: the fixed step, or the largest step when adaptive.
-        adaptive: adapt the step to the contact impulse: a step whose impulse exceeds
-            ``impulse_tol`` is rejected and shrunk by the ratio, accepted steps grow it cautiously
-            (x1.25) back up to ``dt``. False: fixed steps ``dt``. Either way a rejected step (Newton
-            failure, energy gain, intrusion, self-intersection) is retried with half the step;
-            fixed, a halved step doubles back after each accepted step until it is ``dt`` again.
+        dt: time step (s) in (0, 1]: the largest step when adaptive (default 0.01 s), or the fixed
+            step.
+        adaptive: True (default): adapt the step to the error (``rtol``) or the contact impulse
+            (``impulse_tol``): a step above either is rejected and shrunk, accepted steps grow it
+            (at most x1.25 after an impulse bound, by the error's ratio under error control) back up
+            to ``dt``. False: fixed steps ``dt`` (choose it: the default 0.01 s is a largest step).
+            Either way a rejected step (Newton failure, energy gain, intrusion, self-intersection) is
+            retried with half the step; fixed, a halved step doubles back after each accepted step
+            until it is ``dt`` again.
         dt_min: smallest step (s) before simulate() gives up with SimulationError, in (0, dt].
         newton_tol: Newton tolerance on the residual relative to the forces it balances
             (dimensionless), in [1e-14, 1e-2].
@@ -362,8 +390,8 @@ class Scene:
     grounds: Sequence[Ground] = ()
     drums: Sequence[Drum] = ()
     contact: str = "mass_modification"
-    impulse_tol: float = 5e-3
-    rtol: float = 0.0
+    impulse_tol: float | None = None
+    rtol: float | None = None
     atol: float = 0.0
     contact_error: str = "impulse"
     friction_regularization: float = 1e-2
@@ -372,8 +400,8 @@ class Scene:
     damping_mode: str = "rigid"
     integrator: str = "generalized_alpha"
     rho_infinity: float = 0.9
-    dt: float = 1e-4
-    adaptive: bool = False
+    dt: float = 1e-2
+    adaptive: bool = True
     dt_min: float = 1e-9
     newton_tol: float = 1e-9
     newton_max_iter: int = 25
@@ -393,8 +421,7 @@ class Scene:
         s(self, "grounds", check_sequence(o, "grounds", self.grounds, Ground, allow_empty=True))
         s(self, "drums", check_sequence(o, "drums", self.drums, Drum, allow_empty=True))
         s(self, "contact", check_choice(o, "contact", self.contact, CONTACT_METHODS))
-        s(self, "impulse_tol", check_real(o, "impulse_tol", self.impulse_tol, 0.0, 10.0, "N s", True))
-        s(self, "rtol", check_real(o, "rtol", self.rtol, 0.0, 1.0))
+        _check_step_tolerances(self)
         s(self, "atol", check_real(o, "atol", self.atol, 0.0, 1.0, "m"))
         s(self, "contact_error", check_choice(o, "contact_error", self.contact_error, CONTACT_ERRORS))
         s(
@@ -439,6 +466,15 @@ class Scene:
         if not isinstance(self.ring_collision, bool):
             _fail(o, "ring_collision", self.ring_collision, "True or False")
         check_choice(o, "self_intersection", self.self_intersection, SELF_INTERSECTION)
+
+    @property
+    def step_rtol(self) -> float:
+        """The relative tolerance the adaptive step keeps: ``rtol`` when given; otherwise 0 (error
+        control off, the step follows ``impulse_tol``) when ``impulse_tol`` is given, else
+        :data:`DEFAULT_RTOL`."""
+        if self.rtol is not None:
+            return self.rtol
+        return 0.0 if self.impulse_tol is not None else DEFAULT_RTOL
 
     @property
     def gravity_vector(self) -> tuple[float, float]:

@@ -409,9 +409,10 @@ class Simulation:
 
     def _failure_message(self, status: int) -> str:
         scene, t = self.scene, self.t
-        if status == STATUS_IMPULSE_AT_DT_MIN and scene.rtol > 0.0:
+        if status == STATUS_IMPULSE_AT_DT_MIN and scene.step_rtol > 0.0:
+            rtol = scene.step_rtol
             return (
-                f"the contact impulse per step or the local error stayed above Scene.rtol = {scene.rtol:g} "
+                f"the contact impulse per step or the local error stayed above Scene.rtol = {rtol:g} "
                 f"at the smallest step Scene.dt_min = {scene.dt_min:g} s (t = {t:.6g} s); raise rtol or "
                 "atol, or lower dt_min."
             )

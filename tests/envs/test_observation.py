@@ -12,11 +12,11 @@ from ballenv.envs import batch as ball_batch
 from ballenv.envs import observation
 from ballenv.envs.config import BallEnvConfig
 from ballenv.envs.inflated_ball import InflatedBallEnv
+from ballenv.envs.numerics import ENV_FIDELITIES
 from ballenv.envs.vector import InflatedBallVectorEnv
-from ballenv.physics.presets import FIDELITY_PRESETS
 
 MODES = ("pressure", "paddle")
-NODE_COUNTS = sorted({preset["n_nodes"] for preset in FIDELITY_PRESETS.values()} | {3, 7})
+NODE_COUNTS = sorted({preset["n_nodes"] for preset in ENV_FIDELITIES.values()} | {3, 7})
 
 
 @pytest.mark.parametrize("paddle", [False, True])
@@ -41,7 +41,7 @@ def test_compiled_field_starts_agree_with_the_structure(paddle):
 
 
 @pytest.mark.parametrize("mode", MODES)
-@pytest.mark.parametrize("fidelity", list(FIDELITY_PRESETS))
+@pytest.mark.parametrize("fidelity", list(ENV_FIDELITIES))
 def test_bounds_have_the_declared_size_and_values(mode, fidelity):
     config = BallEnvConfig(action_mode=mode, fidelity=fidelity)
     paddle = mode == "paddle"

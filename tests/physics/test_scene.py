@@ -5,6 +5,8 @@ import math
 import pytest
 
 from ballenv.physics import Ring, Scene, simulate
+from ballenv.physics.integrator import build_solver
+from ballenv.physics.scene import DEFAULT_RTOL
 
 
 @pytest.mark.parametrize(
@@ -81,6 +83,25 @@ def test_error_message_names_value_and_range():
     assert str(err.value) == (
         "Ring.youngs_modulus = -1.0 is out of range: must be a finite number in (0, 1e+12] Pa"
     )
+
+
+def test_the_default_step_is_adaptive_under_error_control():
+    scene = Scene()
+    assert scene.adaptive and scene.dt == 1e-2 and scene.step_rtol == DEFAULT_RTOL == 1e-2
+    assert build_solver(scene).rtol == DEFAULT_RTOL
+    assert Scene(adaptive=False).dt == 1e-2 and build_solver(Scene(adaptive=False)).rtol == 0.0
+
+
+def test_an_impulse_bound_alone_turns_error_control_off_and_both_are_a_clear_error():
+    assert Scene(impulse_tol=2e-3).step_rtol == 0.0
+    assert Scene(rtol=1e-3).step_rtol == 1e-3
+    assert Scene(rtol=0.0, impulse_tol=2e-3).step_rtol == 0.0  # the env's form
+    with pytest.raises(ValueError) as err:
+        Scene(rtol=1e-3, impulse_tol=2e-3)
+    assert str(err.value).startswith("Scene.impulse_tol = 0.002 is invalid with Scene.rtol = 0.001: give one")
+    with pytest.raises(ValueError, match=r"Scene\.impulse_tol = None is invalid with Scene\.rtol = 0"):
+        Scene(rtol=0.0)
+    assert Scene(rtol=0.0, adaptive=False).step_rtol == 0.0  # fixed steps need no bound
 
 
 @pytest.mark.parametrize("t_end", [0.0, -1.0, math.nan, "1"])

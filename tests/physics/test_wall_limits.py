@@ -185,7 +185,8 @@ FOLDING = Scene(
                 density=2068.0, pressure=971.9, position=(0.0, 0.3419), velocity=(18.55, -21.0),
                 angular_velocity=-1.783)],
     grounds=[Ground(friction=1.233)], contact="predictor_corrector", gravity=5.034, damping=50.0,
-    integrator="backward_euler", dt=1.133e-3, adaptive=True, atmospheric_pressure=0.0, gas_exponent=1.4,
+    integrator="backward_euler", dt=1.133e-3, adaptive=True, impulse_tol=5e-3, atmospheric_pressure=0.0,
+    gas_exponent=1.4,
 )  # fmt: skip
 
 

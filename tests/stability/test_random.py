@@ -176,7 +176,7 @@ SCENE_FIELDS = {
     ),  # fmt: skip
     "grounds": st.one_of(st.just([1.0]), st.just(3), st.just([Ring()])),
     "contact": bad_choice(("mass_modification", "predictor_corrector")),
-    "impulse_tol": open_low(0.0, 10.0),
+    "impulse_tol": open_low(0.0, 10.0).filter(lambda v: v is not None),  # None: the default, valid
     "friction_regularization": open_low(0.0, 1.0),
     "gravity": st.one_of(
         out_of(0.0, 1000.0).filter(lambda v: not isinstance(v, (list, tuple))),
@@ -188,7 +188,7 @@ SCENE_FIELDS = {
     "rho_infinity": out_of(0.0, 1.0),
     "dt": open_low(0.0, 1.0),
     "adaptive": NOT_A_BOOL,
-    "dt_min": st.one_of(open_low(0.0, 1e-4), st.floats(1e-4, 1.0, exclude_min=True)),  # dt = 1e-4
+    "dt_min": st.one_of(open_low(0.0, 1e-2), st.floats(1e-2, 1.0, exclude_min=True)),  # dt = 1e-2
     "newton_tol": out_of(1e-14, 1e-2),
     "newton_max_iter": out_of(1, 200, integer=True),
     "newton_rescue_max_iter": out_of(0, 200, integer=True),
