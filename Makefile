@@ -45,8 +45,9 @@ bench: $(STAMP)
 	$(PY) benchmarks/work_precision.py
 	$(PY) benchmarks/env_throughput.py
 
-soak: $(STAMP)  # the stability soak (about 10 minutes), not part of test or bench
+soak: $(STAMP)  # the stability soak (about 15 minutes), not part of test or bench
 	$(PY) benchmarks/soak.py
+	$(PY) benchmarks/soak.py --episodes 0 --rtol 0.01 --out benchmarks/results/soak_rtol.md
 
 lint: $(STAMP)
 	$(PY) -m ruff check .

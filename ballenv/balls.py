@@ -231,11 +231,11 @@ FIVB = "FIVB Official Volleyball Rules, 3.1 (circumference 65-67 cm, mass 260-28
 
 # damping (1/s) fitted by benchmarks/ball_calibration.py: the middle of each rule's rebound range
 FITTED_DAMPING = {
-    "basketball": 96.72,
-    "tennis_ball": 197.96,
-    "football": 23.43,
-    "paper_basketball": 83.78,
-    "paper_tennis_ball": 20.41,
+    "basketball": 96.96,
+    "tennis_ball": 202.66,
+    "football": 23.63,
+    "paper_basketball": 82.78,
+    "paper_tennis_ball": 20.60,
 }
 
 

@@ -34,8 +34,8 @@ from ballenv.physics.ring import bending_stiffness  # noqa: E402
 
 RESULTS = ROOT / "benchmarks" / "results"
 PRESSURE_FACTORS = (0.0, 0.2, 0.6, 0.8, 1.0, 1.2, 1.4)
-# the numerical reference: the "accurate" preset with half its largest step and a quarter of its impulse bound
-REFERENCE_NUMERICS = {"dt": 2.5e-3, "impulse_tol": 1.25e-4}
+# the numerical reference: the "accurate" preset with half its largest step and a quarter of its rtol
+REFERENCE_NUMERICS = {"dt": 2.5e-3, "rtol": 7.5e-4}
 
 # published measurements next to the model's (where we found them)
 PUBLISHED = {
@@ -209,7 +209,7 @@ Published measurements found for comparison:
 {chr(10).join(convergence_table(rows))}
 
 *The same drop at the reference: the "accurate" preset (N = 128; the density kept, so the mass
-changes by 0.1 %) with half its largest step (2.5 ms) and a quarter of its impulse bound (1.25e-4 N s).*
+changes by 0.1 %) with half its largest step (2.5 ms) and a quarter of its rtol (7.5e-4).*
 
 ## Rebound against pressure
 

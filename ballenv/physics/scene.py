@@ -289,8 +289,8 @@ def _check_step_tolerances(scene: "Scene") -> None:
     if scene.impulse_tol is not None and scene.rtol:
         raise ValueError(
             f"Scene.impulse_tol = {scene.impulse_tol!r} is invalid with Scene.rtol = {scene.rtol!r}: give "
-            "one of them (rtol > 0 sets its own bound on the contact impulse; rtol = 0 turns error "
-            "control off)"
+            "one of them (rtol > 0 sets its own bound on the contact impulse; impulse_tol with rtol None "
+            "or 0 turns error control off)"
         )
     if scene.adaptive and scene.step_rtol == 0.0 and scene.impulse_tol is None:
         raise ValueError(
@@ -324,7 +324,7 @@ class Scene:
             (m, ``R`` the ring's radius), and the error in contact as ``contact_error`` says, so the
             same ``rtol`` asks the same relative accuracy of a 3 g ring and a 500 g ball. What it
             achieves on six balls: ``benchmarks/accuracy.py`` (the default's first-apex error
-            0.04-0.7 % on them, in 1/10-1/3 of the wall time of fixed 0.1 ms steps).
+            0.04-0.7 % on them, in 10-43 % of the wall time of fixed 0.1 ms steps).
         contact_error: how ``rtol`` controls a step with a node on a ground at either end.
             "impulse" (default): the contact impulse (as for ``impulse_tol``) at most
             ``rtol M sqrt(g R)`` (N s, ``M`` the ring's mass: the momentum of the ring falling its own
