@@ -18,9 +18,9 @@ accurate   128     0.005 s      0.0005 N s    1e-10
 What each costs per env step: ``benchmarks/env_throughput.py`` and ``benchmarks/env_profile.py``.
 """
 
-import dataclasses
 from typing import Any
 
+from ..physics.presets import with_numerics
 from ..physics.scene import Scene
 
 ENV_FIDELITIES: dict[str, dict[str, Any]] = {
@@ -34,10 +34,9 @@ ENV_RHO_INFINITY = 0.3  # generalized-alpha's high-frequency damping in every fi
 def with_env_fidelity(scene: Scene, fidelity: str) -> Scene:
     """``scene`` with the env's numerical settings of ``fidelity`` (a key of :data:`ENV_FIDELITIES`)."""
     numerics = ENV_FIDELITIES[fidelity]
-    rings = tuple(dataclasses.replace(r, n_nodes=numerics["n_nodes"]) for r in scene.rings)
-    return dataclasses.replace(
+    return with_numerics(
         scene,
-        rings=rings,
+        numerics["n_nodes"],
         integrator="generalized_alpha",
         adaptive=True,
         rtol=0.0,

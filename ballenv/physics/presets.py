@@ -52,15 +52,22 @@ def with_fidelity(scene: Scene, fidelity: str) -> Scene:
     if not isinstance(scene, Scene):
         raise ValueError(f"with_fidelity.scene = {scene!r} is invalid: must be a ballenv.physics.Scene")
     preset = FIDELITY_PRESETS[fidelity]
-    rings = tuple(dataclasses.replace(r, n_nodes=preset["n_nodes"]) for r in scene.rings)
-    return dataclasses.replace(
+    return with_numerics(
         scene,
-        rings=rings,
+        preset["n_nodes"],
         integrator="generalized_alpha",
         adaptive=True,
         rtol=preset["rtol"],
+        impulse_tol=None,  # the preset's rtol sets the contact bound, whatever the scene had
         contact_error="impulse",
         dt=preset["dt"],
         newton_tol=preset["newton_tol"],
         rho_infinity=PRESET_RHO_INFINITY,
     )
+
+
+def with_numerics(scene: Scene, n_nodes: int, **numerics: Any) -> Scene:
+    """``scene`` with every ring at ``n_nodes`` nodes and the Scene fields ``numerics``; the physics
+    (material, pressure, effects) untouched."""
+    rings = tuple(dataclasses.replace(r, n_nodes=n_nodes) for r in scene.rings)
+    return dataclasses.replace(scene, rings=rings, **numerics)

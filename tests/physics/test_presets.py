@@ -29,6 +29,11 @@ def test_preset_sets_the_numerics_and_keeps_the_physics(name):
     assert out.grounds == scene.grounds and out.damping == 2.0
 
 
+def test_a_preset_replaces_the_scenes_own_step_control():
+    out = with_fidelity(Scene(impulse_tol=1e-3, dt=1e-4, adaptive=False), "balanced")
+    assert (out.impulse_tol, out.step_rtol, out.adaptive, out.dt) == (None, 0.02, True, 1e-2)
+
+
 def test_unknown_preset_is_a_clear_error():
     with pytest.raises(ValueError, match="fidelity"):
         with_fidelity(Scene(), "ultra")
