@@ -1,16 +1,17 @@
 """Accuracy you ask for: the first-apex error that a requested tolerance ``Scene.rtol`` achieves on six
-balls that differ in what dominates them (``ball_family.py``), its cost, and the fidelity presets on
-the same balls.
+balls that differ in what dominates them (``ball_family.py``), its cost, the fidelity presets on
+the same balls against their stated bounds, the node count's own error, and ``Scene``'s default step
+against the former fixed 0.1 ms steps.
 
     python benchmarks/accuracy.py          # writes benchmarks/results/accuracy.md and .png
     python benchmarks/accuracy.py --quick  # two tolerances, the references from the cache
 
 Error: the first-apex height of the centre of mass, relative to the ball's converged reference
 (``ball_family.reference_apex``: the contact impulse per step at most 5e-5 ``M sqrt(g R)``, its own
-error estimated against twice that). The references are cached in
-``benchmarks/results/accuracy_references.json`` (``--references`` recomputes them: about 6
-minutes). Cost: wall time (median of three runs, numba warm), accepted and rejected steps. All
-runs: generalized-alpha, ``rho_infinity`` = 0.9, adaptive, largest step 10 ms, N = 64. Each
+error estimated against twice that), at N = 64 and at the presets' node counts. The references are
+cached in ``benchmarks/results/accuracy_references.json`` (``--references`` recomputes them: about
+10 minutes). Cost: wall time (median of three runs, numba warm), accepted and rejected steps. The
+sweep: generalized-alpha, ``rho_infinity`` = 0.9, adaptive, largest step 10 ms, N = 64. Each
 tolerance with both controls of the step in contact (``Scene.contact_error``): "impulse" (the
 contact impulse at most ``rtol M sqrt(g R)``) and "doubling" (the contact errors of
 ``ballenv/physics/contact_error.py``); the table says per ball and control whether the error fell at
