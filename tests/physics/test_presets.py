@@ -62,7 +62,7 @@ def test_each_preset_keeps_its_stated_error_on_every_ball(preset_errors, preset,
 
 def test_the_worst_error_over_the_balls_falls_from_fast_to_balanced_to_accurate(preset_errors):
     worst = [max(e for (p, _), e in preset_errors.items() if p == preset) for preset in FIDELITY_PRESETS]
-    assert worst[0] > 2.0 * worst[1] > 4.0 * worst[2]  # measured 1.6e-2, 6e-3, 5.6e-4
+    assert worst[0] > 2.0 * worst[1] > 4.0 * worst[2]  # measured 1.6e-2, 6.1e-3, 5.6e-4
 
 
 def test_the_references_are_converged_well_inside_the_bounds():
