@@ -32,8 +32,10 @@ import time  # noqa: E402
 
 from ball_family import BALLS, ball_scene, first_apex, gas_to_bending, reference_apex  # noqa: E402
 
-from ballenv.physics import Ground, Simulation, SimulationError, simulate  # noqa: E402
+from ballenv.physics import Ground, SimulationError, simulate  # noqa: E402
 from ballenv.physics.presets import FIDELITY_PRESETS, with_fidelity  # noqa: E402
+from ballenv.physics.scene import DEFAULT_RTOL  # noqa: E402
+from ballenv.physics.simulation import initial_state  # noqa: E402
 
 RESULTS = pathlib.Path(__file__).parent / "results"
 REFERENCES = RESULTS / "accuracy_references.json"
@@ -43,6 +45,9 @@ NUMERICS = dict(adaptive=True, dt=1e-2, rho_infinity=0.9)
 SWEEP_NODES = 64  # node count of the rtol sweep
 FORMER_DEFAULT = dict(adaptive=False, dt=1e-4)  # Scene's step before it was error-controlled
 REST_SECONDS = 30.0  # s: the ball at rest of the default's table
+# Scene's default step is the sweep's NUMERICS with rtol DEFAULT_RTOL and the "impulse" control
+# (tests/physics/test_scene.py checks the defaults): its runs are that row of the sweep
+DEFAULT_RUN = f"impulse rtol={DEFAULT_RTOL:g}"
 REFERENCE_NODES = sorted({SWEEP_NODES} | {p["n_nodes"] for p in FIDELITY_PRESETS.values()})
 
 
@@ -93,7 +98,6 @@ def sweep(refs, tolerances, progress=print):
         for preset, numerics in FIDELITY_PRESETS.items():  # against the reference at its node count
             preset_ref = refs[str(numerics["n_nodes"])][name]["apex"]
             runs[name][preset] = measure(name, with_fidelity(ball_scene(name), preset), preset_ref)
-        runs[name]["default"] = measure(name, ball_scene(name, SWEEP_NODES), ref)
         runs[name]["former default"] = measure(name, ball_scene(name, SWEEP_NODES, **FORMER_DEFAULT), ref, 1)
         progress(f"{name}: " + ", ".join(f"{k} {v['error']:.1e}" for k, v in runs[name].items()))
     return runs
@@ -206,7 +210,7 @@ def resting_walls():
 
 def resting_nodes(scene):
     """The ring of ``scene`` moved down to rest its lowest node on the floor (nodes, m)."""
-    x = Simulation(scene).state.x[0].copy()
+    x = initial_state(scene)[0][0]
     x[:, 1] -= x[:, 1].min()
     return x
 
@@ -224,7 +228,7 @@ def default_table(runs):
         "|---|---:|---:|",
     ]
     for name in BALLS:
-        cells = [runs[name][k] for k in ("default", "former default")]
+        cells = [runs[name][k] for k in (DEFAULT_RUN, "former default")]
         lines.append(
             f"| {name} | "
             + " | ".join(f"{r['error']:.1e}, {r['wall'] * 1e3:.0f}, {r['steps']}" for r in cells)

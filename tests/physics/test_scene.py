@@ -88,6 +88,7 @@ def test_error_message_names_value_and_range():
 def test_the_default_step_is_adaptive_under_error_control():
     scene = Scene()
     assert scene.adaptive and scene.dt == 1e-2 and scene.step_rtol == DEFAULT_RTOL == 1e-2
+    assert scene.contact_error == "impulse" and scene.rho_infinity == 0.9  # benchmarks/accuracy.py's row
     assert build_solver(scene).rtol == DEFAULT_RTOL
     assert Scene(adaptive=False).dt == 1e-2 and build_solver(Scene(adaptive=False)).rtol == 0.0
 
