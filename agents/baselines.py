@@ -101,7 +101,9 @@ class ModelPolicy:
 
     The observation wrapper the run was trained behind (``env_wrapper`` in its ``config.yml``) and
     the observation normalisation (``vecnormalize.pkl`` next to it, ``best_vecnormalize.pkl`` for
-    ``best_model.zip``) are applied, the latter frozen, if present.
+    ``best_model.zip``) are applied, the latter frozen, if present; a wrapper that also acts
+    (``action`` and ``restart`` methods: ``agents.wrappers.ResidualPump``) turns the model's action
+    into the env's and is restarted at each episode start.
     """
 
     name = "trained"
@@ -133,7 +135,9 @@ class ModelPolicy:
                 self.normalize = normalize
 
     def reset(self, seed: int) -> None:
-        pass
+        restart = getattr(self.wrapper, "restart", None)
+        if restart is not None:
+            restart()
 
     def act(self, obs: NDArray[np.float32]) -> NDArray[np.float32]:
         if self.wrapper is not None:
@@ -141,7 +145,9 @@ class ModelPolicy:
         if self.normalize is not None:
             obs = self.normalize.normalize_obs(obs).astype(np.float32)
         action, _ = self.model.predict(obs, deterministic=True)
-        return np.asarray(action, dtype=np.float32).reshape(1)
+        action = np.asarray(action, dtype=np.float32).reshape(1)
+        to_env = getattr(self.wrapper, "action", None)  # a wrapper that also acts (ResidualPump)
+        return action if to_env is None else np.asarray(to_env(action), dtype=np.float32).reshape(1)
 
 
 def _run_wrapper(path: pathlib.Path, env: gym.Env[Any, Any]) -> gym.ObservationWrapper[Any, Any, Any] | None:

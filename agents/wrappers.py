@@ -1,12 +1,15 @@
-"""Observation wrappers an agent may train behind, named in the hyperparameter files by RL Baselines3
-Zoo's ``env_wrapper`` key (``agents.wrappers.BallStateObservation``, the ball as a body, or
-``agents.wrappers.BallShapeObservation``, which adds the ring's low shape modes); ``agents.train``
-applies it to the training and evaluation envs and ``agents.evaluate`` to a saved model's env."""
+"""Wrappers an agent may train behind, named in the hyperparameter files by RL Baselines3 Zoo's
+``env_wrapper`` key (``agents.wrappers.BallStateObservation``, the ball as a body,
+``agents.wrappers.BallShapeObservation``, which adds the ring's low shape modes, or
+``agents.wrappers.ResidualPump``, the agent as a correction on the tuned pump); ``agents.train``
+applies it to the training and evaluation envs and ``agents.evaluate`` to a saved model's env (a
+wrapper with ``action`` and ``restart`` methods also turns the model's actions into the env's and
+is restarted at each episode start)."""
 
 from __future__ import annotations
 
 import importlib
-from typing import Any
+from typing import Any, SupportsFloat
 
 import gymnasium as gym
 import numpy as np
@@ -117,6 +120,59 @@ class BallShapeObservation(BallStateObservation):
         displacement = radial_modes(distance - self.radius, angle, SHAPE_MODES) / self.radius
         rate = radial_modes(radial_velocity, angle, SHAPE_MODES) / self.speed_scale
         return np.concatenate([displacement, rate])
+
+
+RESIDUAL_SCALE = 0.1  # the residual's full range, in the env's action units
+
+
+class ResidualPump(BallStateObservation):
+    """The agent as a correction on the tuned ``PressurePump`` (residual policy learning): the env's
+    action is ``clip(u_pump + RESIDUAL_SCALE a, -1, 1)``, ``u_pump`` the pump's action for the
+    present observation and ``a`` in [-1, 1] the agent's; the agent observes the ball as a body
+    (:class:`BallStateObservation`) and ``u_pump`` (10 entries). A zero action is the pump. Pressure
+    mode only. It holds the pump's memory of the bounce: :meth:`observation` asks the pump once per
+    step, :meth:`action` adds the agent's correction to that answer, :meth:`restart` clears the
+    memory at an episode start (``reset`` calls it; ``agents.evaluate`` calls all three on the raw
+    env's observations)."""
+
+    def __init__(self, env: gym.Env[NDArray[np.float32], NDArray[np.float32]]) -> None:
+        from .baselines import HeuristicPolicy
+
+        super().__init__(env)
+        mode = ball_env(env).config.action_mode
+        if mode != "pressure":
+            raise ValueError(
+                f"ResidualPump: action_mode = {mode!r} is invalid: it corrects the pump, valid: 'pressure'"
+            )
+        self.pump = HeuristicPolicy(env).controller
+        self.pump_action = np.zeros(1, dtype=np.float32)
+        space = self.observation_space
+        assert isinstance(space, gym.spaces.Box), space
+        self.observation_space = gym.spaces.Box(
+            np.append(space.low, -1.0).astype(np.float32), np.append(space.high, 1.0).astype(np.float32)
+        )
+
+    def restart(self) -> None:
+        """Clear the pump's memory of the bounce (an episode starts)."""
+        self.pump.reset()
+
+    def reset(self, **kwargs: Any) -> tuple[NDArray[np.float32], dict[str, Any]]:
+        self.restart()
+        return super().reset(**kwargs)
+
+    def observation(self, observation: NDArray[np.float32]) -> NDArray[np.float32]:
+        self.pump_action = self.pump.act(observation)
+        return np.append(super().observation(observation), self.pump_action).astype(np.float32)
+
+    def action(self, action: NDArray[np.float32]) -> NDArray[np.float32]:
+        """The env's action: the pump's last answer plus ``RESIDUAL_SCALE`` times ``action``."""
+        correction = RESIDUAL_SCALE * np.asarray(action, dtype=np.float32).reshape(1)
+        return np.clip(self.pump_action + correction, -1.0, 1.0).astype(np.float32)
+
+    def step(
+        self, action: NDArray[np.float32]
+    ) -> tuple[NDArray[np.float32], SupportsFloat, bool, bool, dict[str, Any]]:
+        return super().step(self.action(action))
 
 
 def radial_modes(values: NDArray[np.float64], angles: NDArray[np.float64], n_max: int) -> NDArray[np.float64]:

@@ -1,4 +1,5 @@
-"""agents.wrappers: the ball-state observation, and a run trained behind it evaluates behind it."""
+"""agents.wrappers: the ball-state observation, the residual on the pump, and a run trained behind a
+wrapper evaluates behind it."""
 
 import json
 import pathlib
@@ -10,11 +11,14 @@ import numpy as np
 import pytest
 
 import ballenv  # noqa: F401  (registers the env)
+from agents.baselines import HeuristicPolicy
 from agents.evaluate import evaluate
 from agents.wrappers import (
+    RESIDUAL_SCALE,
     SHAPE_MODES,
     BallShapeObservation,
     BallStateObservation,
+    ResidualPump,
     radial_modes,
     wrapper_class,
 )
@@ -120,13 +124,44 @@ def test_a_wrapper_name_that_does_not_import_is_one_readable_error():
         wrapper_class("agents.wrappers.Nope")
 
 
-def test_a_run_trained_behind_the_wrapper_is_evaluated_behind_it(tmp_path):
-    hp = {
-        "n_steps": 64,
-        "batch_size": 64,
-        "n_epochs": 1,
-        "env_wrapper": "agents.wrappers.BallStateObservation",
-    }
+def test_a_zero_residual_is_the_pump():
+    """Behind ``ResidualPump`` the action 0 at every step runs the episode the tuned pump runs on
+    the raw env, and the agent sees the pump's action as its last entry."""
+    env = ResidualPump(gym.make("InflatedBall-v3", max_episode_steps=150))
+    raw = gym.make("InflatedBall-v3", max_episode_steps=150)
+    pump = HeuristicPolicy(raw)
+    obs, _ = env.reset(seed=3)
+    full, _ = raw.reset(seed=3)
+    pump.reset(3)
+    rewards, done = [], False
+    while not done:
+        action = pump.act(full)
+        assert obs[-1] == action[0]
+        np.testing.assert_array_equal(obs[:-1], BallStateObservation(raw).observation(full))
+        obs, r_wrapped, *_ = env.step(np.zeros(1, dtype=np.float32))
+        full, r_raw, terminated, truncated, _ = raw.step(action)
+        rewards.append((r_wrapped, r_raw))
+        done = terminated or truncated
+    assert len(rewards) == 150 and all(a == b for a, b in rewards)
+
+
+def test_the_residual_corrects_the_pump_within_its_scale():
+    env = ResidualPump(gym.make("InflatedBall-v3"))
+    obs, _ = env.reset(seed=0)
+    assert env.observation_space.shape == (10,) and env.observation_space.contains(obs)
+    for a in (-1.0, 0.5, 1.0):
+        expected = np.clip(obs[-1] + RESIDUAL_SCALE * a, -1.0, 1.0)
+        assert env.action(np.array([a], dtype=np.float32))[0] == pytest.approx(expected)
+
+
+def test_the_residual_is_for_the_pressure_mode_only():
+    with pytest.raises(ValueError, match="action_mode = 'paddle' is invalid"):
+        ResidualPump(gym.make("InflatedBall-v3", action_mode="paddle"))
+
+
+@pytest.mark.parametrize("wrapper", ["agents.wrappers.BallStateObservation", "agents.wrappers.ResidualPump"])
+def test_a_run_trained_behind_the_wrapper_is_evaluated_behind_it(tmp_path, wrapper):
+    hp = {"n_steps": 64, "batch_size": 64, "n_epochs": 1, "env_wrapper": wrapper}
     command = [
         sys.executable, str(ROOT / "train.py"), "--n-envs", "1", "--total-timesteps", "128",
         "--eval-freq", "64", "--eval-episodes", "1", "--final-episodes", "1", "--no-baselines",
@@ -139,6 +174,31 @@ def test_a_run_trained_behind_the_wrapper_is_evaluated_behind_it(tmp_path):
     scores = json.loads((run / "scores.json").read_text())
     again = evaluate(str(run), {"max_episode_steps": 60}, episodes=1)
     assert again.episode_apex_errors == pytest.approx(scores[0]["episode_apex_errors"])
+    assert again.episode_return == pytest.approx(_return_behind(wrapper_class(wrapper), run, 60))
+
+
+def _return_behind(cls, run, steps):
+    """The return of the first held-out episode (``agents.evaluate``'s seed) of ``run``'s best model
+    stepping the env behind ``cls`` itself, as in training (observations normalised with the saved
+    statistics)."""
+    import pickle
+
+    from stable_baselines3 import PPO
+
+    from agents.evaluate import DEFAULT_SEED
+
+    model = PPO.load(run / "best_model.zip", device="cpu")
+    with open(run / "best_vecnormalize.pkl", "rb") as f:
+        normalize = pickle.load(f)
+    env = cls(gym.make("InflatedBall-v3", max_episode_steps=steps))
+    obs, _ = env.reset(seed=DEFAULT_SEED)
+    total, done = 0.0, False
+    while not done:
+        action, _ = model.predict(normalize.normalize_obs(obs).astype(np.float32), deterministic=True)
+        obs, reward, terminated, truncated, _ = env.step(action)
+        total += float(reward)
+        done = terminated or truncated
+    return total
 
 
 def test_a_mistyped_wrapper_stops_train_before_any_run_folder(tmp_path):
