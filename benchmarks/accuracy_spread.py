@@ -1,6 +1,9 @@
-"""What a tolerance achieves over nearby drops: the first-apex error of ``Scene.rtol`` on the six balls
-of ``ball_family.py``, each dropped from five heights (0.94-1.06 times its own), the worst and the
-RMS over the five.
+"""What a tolerance achieves over nearby drops: the first-apex and trajectory errors of ``Scene.rtol``
+on the six balls of ``ball_family.py``, each dropped from five heights (0.94-1.06 times its own):
+the worst first-apex error and the RMS over the five, and the worst trajectory error (the largest
+distance between the run's centre of mass and the reference's until the reference's first apex,
+over its height; the run's centre between its steps is the cubic Hermite spline through its
+recorded positions and velocities, exact in flight).
 
     python benchmarks/accuracy_spread.py   # writes benchmarks/results/accuracy_spread.md (about 5 min)
 
@@ -23,6 +26,7 @@ import time  # noqa: E402
 import numpy as np  # noqa: E402
 from accuracy import CONTROLS, NUMERICS, SWEEP_NODES, TOLERANCES  # noqa: E402
 from ball_family import BALLS, ball_scene, first_apex, reference_scene  # noqa: E402
+from scipy.interpolate import CubicHermiteSpline  # noqa: E402
 
 RESULTS = pathlib.Path(__file__).parent / "results"
 HEIGHT_FACTORS = (0.94, 0.97, 1.0, 1.03, 1.06)  # the drops' start heights over the ball's own
@@ -35,28 +39,81 @@ def lifted(scene, factor):
     return dataclasses.replace(scene, rings=[dataclasses.replace(ring, position=position)])
 
 
-def drop_errors(name, scene, references):
-    """(H,) relative first-apex errors of ``scene`` dropped from each of :data:`HEIGHT_FACTORS`."""
-    apexes = [first_apex(name, lifted(scene, f))[0] for f in HEIGHT_FACTORS]
-    return np.abs(np.array(apexes) - references) / references
+def centre_path(traj):
+    """Ring 0's centre of mass as a cubic Hermite spline of time (m), through its recorded positions
+    and velocities: exact on a flight's parabola whatever the steps."""
+    t, keep = np.unique(traj.t, return_index=True)
+    return CubicHermiteSpline(t, traj.x[keep, 0].mean(axis=1), traj.v[keep, 0].mean(axis=1), axis=0)
+
+
+def reference_drops(name):
+    """Ball ``name``'s reference run dropped from each of :data:`HEIGHT_FACTORS`: (H,) first apexes
+    (m) and H (times (s), centre-of-mass positions (m)) of its records up to its first apex."""
+    reference = reference_scene(name, n_nodes=SWEEP_NODES)
+    apexes, paths = [], []
+    for f in HEIGHT_FACTORS:
+        apex, traj = first_apex(name, lifted(reference, f))
+        apexes.append(apex)
+        until = traj.t <= traj.apexes()[0, 0]
+        paths.append((traj.t[until], traj.x[until, 0].mean(axis=1)))
+    return np.array(apexes), paths
+
+
+def drop_errors(name, scene, references, paths):
+    """(H,) relative first-apex errors and (H,) trajectory errors of ``scene`` dropped from each of
+    :data:`HEIGHT_FACTORS` against the reference drops (:func:`reference_drops`). Trajectory error:
+    the largest distance (m) between the run's centre of mass and the reference's until the
+    reference's first apex, at the reference's records, over that apex's height (m)."""
+    apex_errors, path_errors = [], []
+    for f, reference, (t, centre) in zip(HEIGHT_FACTORS, references, paths, strict=True):
+        apex, traj = first_apex(name, lifted(scene, f))
+        apex_errors.append(abs(apex - reference) / reference)
+        distance = np.hypot(*(centre_path(traj)(t) - centre).T)
+        path_errors.append(distance.max() / reference)
+    return np.array(apex_errors), np.array(path_errors)
 
 
 def spread(progress=print):
-    """ball -> control -> [(rtol, worst error, RMS error) per tolerance]."""
+    """ball -> control -> [(rtol, worst apex error, RMS apex error, worst trajectory error) per
+    tolerance]."""
     out = {}
     for name in BALLS:
-        reference = reference_scene(name, n_nodes=SWEEP_NODES)
-        references = np.array([first_apex(name, lifted(reference, f))[0] for f in HEIGHT_FACTORS])
+        references, paths = reference_drops(name)
         out[name] = {}
         for control in CONTROLS:
             rows = []
             for rtol in TOLERANCES:
                 scene = ball_scene(name, SWEEP_NODES, rtol=rtol, contact_error=control, **NUMERICS)
-                errors = drop_errors(name, scene, references)
-                rows.append((rtol, float(errors.max()), float(np.sqrt(np.mean(errors**2)))))
+                apex, path = drop_errors(name, scene, references, paths)
+                rows.append((rtol, float(apex.max()), float(np.sqrt(np.mean(apex**2))), float(path.max())))
             out[name][control] = rows
-            progress(f"{name} {control}: " + ", ".join(f"{r:g} {w:.1e}" for r, w, _ in rows))
+            progress(f"{name} {control}: " + ", ".join(f"{r:g} {w:.1e} {p:.1e}" for r, w, _, p in rows))
     return out
+
+
+MEASURES = {"worst": 1, "RMS": 2, "trajectory": 3}  # a row's columns: (rtol, worst, RMS, trajectory)
+
+
+def falls(rows, column):
+    """Whether column ``column`` of ``rows`` (one per tolerance, loosest first) falls at every
+    tightening."""
+    return all(b[column] < a[column] for a, b in zip(rows, rows[1:], strict=False))
+
+
+def summary(results, control):
+    """The summary line of ``control``: per measure, its range over rtol and how often it lies within
+    0.3-3 rtol, and on how many balls it falls at every tightening."""
+    parts = []
+    for measure, column in MEASURES.items():
+        rows = [row for by_control in results.values() for row in by_control[control]]
+        ratios = [row[column] / row[0] for row in rows]
+        inside = sum(0.3 <= r <= 3.0 for r in ratios)
+        falling = sum(falls(by_control[control], column) for by_control in results.values())
+        parts.append(
+            f"{measure} {min(ratios):.2f}-{max(ratios):.2f} rtol ({inside} of {len(ratios)} within "
+            f"0.3-3), falling on {falling} of {len(results)} balls"
+        )
+    return f"- {control}: " + "; ".join(parts) + "."
 
 
 def report(results, seconds):
@@ -66,33 +123,24 @@ def report(results, seconds):
         "",
         f"`python benchmarks/accuracy_spread.py` ({seconds / 60:.1f} min). Each ball of "
         f"`benchmarks/ball_family.py` dropped from {len(HEIGHT_FACTORS)} heights "
-        f"({HEIGHT_FACTORS[0]:g}-{HEIGHT_FACTORS[-1]:g} times its own), each against its own reference; "
-        "per tolerance the worst first-apex error over the drops (its ratio to rtol) and their RMS; "
-        "monotone: the worst error fell at every tightening.",
+        f"({HEIGHT_FACTORS[0]:g}-{HEIGHT_FACTORS[-1]:g} times its own), each against its own reference. "
+        "Per tolerance: the worst first-apex error over the drops (its ratio to rtol), their RMS, and the "
+        "worst trajectory error (the largest distance between the run's centre of mass and the "
+        "reference's until the reference's first apex, over its height; its ratio to rtol). "
+        "Falls: whether worst / RMS / trajectory fell at every tightening.",
         "",
         "| ball | control | "
-        + " | ".join(f"rtol {t:g}: worst (worst/rtol), RMS" for t in TOLERANCES)
-        + " | monotone |",
+        + " | ".join(f"rtol {t:g}: worst (/rtol), RMS, trajectory (/rtol)" for t in TOLERANCES)
+        + " | falls: worst / RMS / trajectory |",
         "|---|---|" + "---:|" * len(TOLERANCES) + "---|",
     ]
-    inside = {control: 0 for control in CONTROLS}
-    falling = {control: 0 for control in CONTROLS}
     for name, by_control in results.items():
         for control, rows in by_control.items():
-            cells = [f"{w:.1e} ({w / r:.2f}), {q:.1e}" for r, w, q in rows]
-            falls = all(b[1] < a[1] for a, b in zip(rows, rows[1:], strict=False))
-            inside[control] += sum(0.3 <= w / r <= 3.0 for r, w, _ in rows)
-            falling[control] += falls
-            lines.append(f"| {name} | {control} | " + " | ".join(cells) + f" | {'yes' if falls else 'no'} |")
+            cells = [f"{w:.1e} ({w / r:.2f}), {q:.1e}, {p:.1e} ({p / r:.2f})" for r, w, q, p in rows]
+            fell = " / ".join("yes" if falls(rows, c) else "no" for c in MEASURES.values())
+            lines.append(f"| {name} | {control} | " + " | ".join(cells) + f" | {fell} |")
     lines.append("")
-    runs = len(results) * len(TOLERANCES)
-    for control in CONTROLS:
-        ratios = [w / r for by_control in results.values() for r, w, _ in by_control[control]]
-        lines.append(
-            f"- {control}: worst/rtol {min(ratios):.2f}-{max(ratios):.2f}, within 0.3-3 in {inside[control]} "
-            f"of {runs}; the worst error falls at every tightening on {falling[control]} of {len(results)} "
-            "balls."
-        )
+    lines += [summary(results, control) for control in CONTROLS]
     return "\n".join(lines) + "\n"
 
 
