@@ -27,9 +27,10 @@ scenes: $(STAMP)
 
 # The replay viewer's browser test (tests/test_viewer.py) needs chromium on the PATH (Debian:
 # apt-get install chromium; .ci/run installs it); without it that test skips (fails under CI).
-# make test installs nothing outside .venv.
+# make test installs nothing outside .venv. pytest-xdist runs the test files on every core, each
+# file in one worker (its module fixtures built once).
 test: $(STAMP)
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q -n auto --dist loadfile
 
 test-slow: $(STAMP)
 	$(PY) -m pytest -q -m slow
