@@ -43,7 +43,8 @@ def centre_path(traj):
     """Ring 0's centre of mass as a cubic Hermite spline of time (m), through its recorded positions
     and velocities: exact on a flight's parabola whatever the steps."""
     t, keep = np.unique(traj.t, return_index=True)
-    return CubicHermiteSpline(t, traj.x[keep, 0].mean(axis=1), traj.v[keep, 0].mean(axis=1), axis=0)
+    centre = traj.centre_of_mass()[keep, 0]
+    return CubicHermiteSpline(t, centre, traj.v[keep, 0].mean(axis=1), axis=0)  # equal node masses
 
 
 def reference_drops(name):
@@ -55,7 +56,7 @@ def reference_drops(name):
         apex, traj = first_apex(name, lifted(reference, f))
         apexes.append(apex)
         until = traj.t <= traj.apexes()[0, 0]
-        paths.append((traj.t[until], traj.x[until, 0].mean(axis=1)))
+        paths.append((traj.t[until], traj.centre_of_mass()[until, 0]))
     return np.array(apexes), paths
 
 
