@@ -110,6 +110,11 @@ def report(refs, runs, tolerances):
     return "\n".join(lines + tables) + "\n"
 
 
+def falls_at_every_tightening(errors):
+    """Whether ``errors`` (one per tolerance, loosest first) fall at every tightening."""
+    return all(b < a for a, b in zip(errors, errors[1:], strict=False))
+
+
 def sweep_table(refs, runs, tolerances):
     """Per ball and contact control: error, err/rtol, wall and steps per tolerance."""
     sweep_refs = refs[str(SWEEP_NODES)]
@@ -134,7 +139,7 @@ def sweep_table(refs, runs, tolerances):
             for t, r in zip(tolerances, rs, strict=True):
                 ratios[control].append(r["error"] / t)
                 cells.append(f"{r['error']:.1e} ({r['error'] / t:.2f}), {r['wall'] * 1e3:.0f}, {r['steps']}")
-            falls = all(b["error"] < a["error"] for a, b in zip(rs, rs[1:], strict=False))
+            falls = falls_at_every_tightening([r["error"] for r in rs])
             ref = sweep_refs[name]
             lines.append(
                 f"| {name} | {control} | {gas_to_bending(name):,.1f} | {ref['apex']:.5f} | "

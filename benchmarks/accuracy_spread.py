@@ -24,7 +24,7 @@ import pathlib  # noqa: E402
 import time  # noqa: E402
 
 import numpy as np  # noqa: E402
-from accuracy import CONTROLS, NUMERICS, SWEEP_NODES, TOLERANCES  # noqa: E402
+from accuracy import CONTROLS, NUMERICS, SWEEP_NODES, TOLERANCES, falls_at_every_tightening  # noqa: E402
 from ball_family import BALLS, ball_scene, first_apex, reference_scene  # noqa: E402
 from scipy.interpolate import CubicHermiteSpline  # noqa: E402
 
@@ -98,7 +98,7 @@ MEASURES = {"worst": 1, "RMS": 2, "trajectory": 3}  # a row's columns: (rtol, wo
 def falls(rows, column):
     """Whether column ``column`` of ``rows`` (one per tolerance, loosest first) falls at every
     tightening."""
-    return all(b[column] < a[column] for a, b in zip(rows, rows[1:], strict=False))
+    return falls_at_every_tightening([row[column] for row in rows])
 
 
 def summary(results, control):

@@ -350,8 +350,8 @@ class Scene:
             step.
         adaptive: True (default): adapt the step to the error (``rtol``) or the contact impulse
             (``impulse_tol``): a step above either is rejected and shrunk, accepted steps grow it
-            (at most x1.25 after an impulse bound, by the error's ratio under error control) back up
-            to ``dt``. False: fixed steps ``dt`` (choose it: the default 0.01 s is a largest step).
+            by at most x1.25 back up to ``dt``. False: fixed steps ``dt`` (choose it: the default
+            0.01 s is a largest step).
             Either way a rejected step (Newton failure, energy gain, intrusion, self-intersection) is
             retried with half the step; fixed, a halved step doubles back after each accepted step
             until it is ``dt`` again.
