@@ -32,7 +32,8 @@ integrator's. Three measures, each at most 1 within tolerance, cover it:
   on the six balls of ``benchmarks/ball_family.py`` (``benchmarks/accuracy.py``): at 1 the achieved
   first-apex error was 0.08-4.6 times ``rtol`` and, on the bending ball, not monotone in it; at 2
   0.06-3.5 times, monotone on five of the six. (The default, ``contact_error = "impulse"``, bounds
-  the contact impulse alone at ``rtol M sqrt(g R)``: 0.02-0.91 times ``rtol``.)
+  the contact impulse at ``rtol M sqrt(g R)`` and lands a step on each first touch
+  (:mod:`.touchdown`): 0.004-0.91 times ``rtol``.)
 
 A ring's rebound and spin follow from its rigid motion, not from the wall's vibration, whose
 velocity field the doubling leaves out (with it, the stiff ball's chattering contact kept the error

@@ -10,9 +10,9 @@ impulse per step at most ``rtol M sqrt(g R)``, ``M`` the ring's mass and ``R`` i
 =========  ======  =====  ==========  ==========  ====================  ==================  ===========
 preset     nodes   rtol   largest dt  newton_tol  first-apex error      measured worst      wall, 1 s
 =========  ======  =====  ==========  ==========  ====================  ==================  ===========
-fast       32      0.1    0.02 s      1e-6        bound 3 %             1.6 %               4-10 ms
-balanced   64      0.02   0.01 s      1e-9        bound 1 %             0.6 %               21-58 ms
-accurate   128     0.003  0.005 s     1e-10       bound 0.3 %           0.06 %              160-730 ms
+fast       32      0.1    0.02 s      1e-6        bound 3 %             0.9 %               4-10 ms
+balanced   64      0.02   0.01 s      1e-9        bound 1 %             0.6 %               21-59 ms
+accurate   128     0.003  0.005 s     1e-10       bound 0.3 %           0.16 %              161-610 ms
 =========  ======  =====  ==========  ==========  ====================  ==================  ===========
 
 The error is that of the step control: the first-apex height of the six balls of

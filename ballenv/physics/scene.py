@@ -324,16 +324,17 @@ class Scene:
             (m, ``R`` the ring's radius), and the error in contact as ``contact_error`` says, so the
             same ``rtol`` asks the same relative accuracy of a 3 g ring and a 500 g ball. What it
             achieves on six balls: ``benchmarks/accuracy.py`` (the default's first-apex error
-            0.04-0.7 % on them, in 10-43 % of the wall time of fixed 0.1 ms steps).
+            0.009-0.46 % on them, in 10-31 % of the wall time of fixed 0.1 ms steps).
         contact_error: how ``rtol`` controls a step with a node on a ground at either end.
             "impulse" (default): the contact impulse (as for ``impulse_tol``) at most
             ``rtol M sqrt(g R)`` (N s, ``M`` the ring's mass: the momentum of the ring falling its own
-            radius). "doubling": the contact errors of ``contact_error.py`` (the distance arriving
+            radius), and the step of a ring in flight ends at its predicted first touch of a ground
+            (``touchdown.py``). "doubling": the contact errors of ``contact_error.py`` (the distance arriving
             nodes still had to go, the step doubling of the ring's rigid motion, the contact impulse
             at most ``2 sqrt(rtol) M sqrt(g R)``): an error closer to proportional to ``rtol``
-            (0.06-3.5 ``rtol`` on the six balls against 0.02-0.91, monotone on five of them against
-            three), at 1.2-3.4x the wall time of "impulse" for the same achieved error on five of
-            the six (the basketball-like ball 1.6x less).
+            (0.06-3.5 ``rtol`` on the six balls against 0.004-0.91, monotone on five of them against
+            four), at about the same or more wall time than "impulse" for the same achieved error on
+            five of the six (the stiff hoop: less).
         atol: absolute local error tolerance on positions (m) in [0, 1], added to ``rtol R``.
         friction_regularization: slip speed eps (m/s) in (0, 1] below which Coulomb friction is
             smoothed, ``mu N v / sqrt(v^2 + eps^2)``. A sticking node creeps at about eps times its

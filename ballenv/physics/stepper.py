@@ -1,7 +1,8 @@
 """The time step of a scene: one trial step of every ring, its acceptance, and the step size.
 
 :func:`advance` repeats :func:`try_step` until a time, in phases: the step's end (:func:`step_end`:
-the step size, output times, the fixed grid and actuation windows), the actuation the step delivers
+the step size, output times, the fixed grid, actuation windows and, under error control, a ring's
+first touch of a ground: :mod:`.touchdown`), the actuation the step delivers
 (:mod:`.drive`: its share of a gas ramp or a spread impulse; nothing without them), the trial step
 of every ring (collision impulses, Newton's iteration with the contact set, :mod:`.newton`), the
 acceptance tests (Newton failure, self-intersection, energy budget, ring intrusion, contact
@@ -61,6 +62,7 @@ from .local_error import error_exponent, error_norm
 from .model import CONTACT_NONE
 from .newton import COUPLED, PLAIN, newton_ring
 from .ring_newton import contact_transfers, joint_newton, pay_from_relative_motion, rings_met, rings_touch
+from .touchdown import touchdown_landing
 
 CONTINUE = -1  # step_outcome(): retry the step
 
@@ -416,8 +418,9 @@ def copy_state(state, trial):
 def step_end(solver, clock, counters, t_end, output_dt, landing):
     """The end of the next step: ``(stop, at_end, at_out, at_grid)``: the time (s) the step from
     ``clock[CLOCK_T]`` with size ``clock[CLOCK_H]`` stops at, shortened to land on the next output
-    time (``output_dt`` > 0), the fixed grid (not adaptive), an actuation's ``landing`` time (s; inf
-    for none: :func:`drive.drive_landing`) and ``t_end``, and which it landed on."""
+    time (``output_dt`` > 0), the fixed grid (not adaptive), the ``landing`` time (s; inf for none:
+    the first of an actuation's window, :func:`drive.drive_landing`, and a ring's first touch,
+    :func:`touchdown.touchdown_landing`) and ``t_end``, and which it landed on."""
     t = clock[CLOCK_T]
     eps = time_tolerance(solver)
     stop = min(t + clock[CLOCK_H], landing)
@@ -517,7 +520,9 @@ def advance(model, solver, ws, state, trial, clock, counters, t_pause, t_end, ou
     (``solver.rtol`` > 0), ``err^(-1/(p+1))`` of the scaled local error ``err``
     (:mod:`.local_error`), and for a step in contact its contact errors (:func:`doubled_step`). A
     step with ``ratio`` < 1 is retried with ``h * max(0.2, 0.9 ratio)``;
-    accepted steps grow by ``min(growth, 1 + (ratio - 1) / 2)`` (cautious), up to ``dt``.
+    accepted steps grow by ``min(growth, 1 + (ratio - 1) / 2)`` (cautious), up to ``dt``. Under
+    error control with the "impulse" contact control, a step of a ring in flight ends at its
+    predicted first touch of a ground (:mod:`.touchdown`).
     """
     capacity = rec.t.shape[0]
     n_rings = state.x.shape[0]
@@ -527,9 +532,9 @@ def advance(model, solver, ws, state, trial, clock, counters, t_pause, t_end, ou
         if model.collide:
             limit = collision_step_limit(state.x, state.v, model.thickness, clock[CLOCK_H], ws.ring_pairs)
             clock[CLOCK_H] = max(min(clock[CLOCK_H], limit), solver.dt_min)
-        landing = math.inf
+        landing = touchdown_landing(model, solver, ws, state, clock[CLOCK_T], clock[CLOCK_H])
         if drive is not None:  # (pruned by numba for a drive of None: no code)
-            landing = drive_landing(solver, clock[CLOCK_T], drive)
+            landing = min(landing, drive_landing(solver, clock[CLOCK_T], drive))
         stop, at_end, at_out, at_grid = step_end(solver, clock, counters, t_end, output_dt, landing)
         if drive is not None:
             drive_step(model, solver, state, clock[CLOCK_T], stop, ws, drive)
