@@ -103,7 +103,9 @@ class ModelPolicy:
     the observation normalisation (``vecnormalize.pkl`` next to it, ``best_vecnormalize.pkl`` for
     ``best_model.zip``) are applied, the latter frozen, if present; a wrapper that also acts
     (``action`` and ``restart`` methods: ``agents.wrappers.ResidualPump``) turns the model's action
-    into the env's and is restarted at each episode start.
+    into the env's and is restarted at each episode start; one that plays the env itself (an ``act``
+    method: ``agents.wrappers.PumpAmplitude``) is given each env observation and asks the model
+    when it needs an action.
     """
 
     name = "trained"
@@ -140,14 +142,22 @@ class ModelPolicy:
             restart()
 
     def act(self, obs: NDArray[np.float32]) -> NDArray[np.float32]:
+        plays = getattr(self.wrapper, "act", None)  # a wrapper that plays the env step by step
+        if plays is not None:
+            return np.asarray(plays(obs, self.decide), dtype=np.float32).reshape(1)
         if self.wrapper is not None:
             obs = self.wrapper.observation(obs)
+        action = self.decide(obs)
+        to_env = getattr(self.wrapper, "action", None)  # a wrapper that also acts (ResidualPump)
+        return action if to_env is None else np.asarray(to_env(action), dtype=np.float32).reshape(1)
+
+    def decide(self, obs: NDArray[np.float32]) -> NDArray[np.float32]:
+        """The model's deterministic action for a wrapped observation (normalised here, if the run
+        normalised its observations)."""
         if self.normalize is not None:
             obs = self.normalize.normalize_obs(obs).astype(np.float32)
         action, _ = self.model.predict(obs, deterministic=True)
-        action = np.asarray(action, dtype=np.float32).reshape(1)
-        to_env = getattr(self.wrapper, "action", None)  # a wrapper that also acts (ResidualPump)
-        return action if to_env is None else np.asarray(to_env(action), dtype=np.float32).reshape(1)
+        return np.asarray(action, dtype=np.float32).reshape(1)
 
 
 def _run_wrapper(path: pathlib.Path, env: gym.Env[Any, Any]) -> gym.ObservationWrapper[Any, Any, Any] | None:

@@ -1,7 +1,8 @@
 """Wrappers an agent may train behind, named in the hyperparameter files by RL Baselines3 Zoo's
 ``env_wrapper`` key (``agents.wrappers.BallStateObservation``, the ball as a body,
-``agents.wrappers.BallShapeObservation``, which adds the ring's low shape modes, or
-``agents.wrappers.ResidualPump``, the agent as a correction on the tuned pump); ``agents.train``
+``agents.wrappers.BallShapeObservation``, which adds the ring's low shape modes,
+``agents.wrappers.BallLandingObservation``, which adds where within a control step the ball will
+land, or ``agents.wrappers.ResidualPump``, the agent as a correction on the tuned pump); ``agents.train``
 applies it to the training and evaluation envs and ``agents.evaluate`` to a saved model's env (a
 wrapper with ``action`` and ``restart`` methods also turns the model's actions into the env's and
 is restarted at each episode start)."""
@@ -120,6 +121,133 @@ class BallShapeObservation(BallStateObservation):
         displacement = radial_modes(distance - self.radius, angle, SHAPE_MODES) / self.radius
         rate = radial_modes(radial_velocity, angle, SHAPE_MODES) / self.speed_scale
         return np.concatenate([displacement, rate])
+
+
+class BallLandingObservation(BallStateObservation):
+    """The ball as a body (:class:`BallStateObservation`), then where within a control step it will
+    next land: ``(cos phi, sin phi)`` of :func:`landing_phase` (11 entries in pressure mode, 14 in
+    paddle mode).
+
+    The env holds an action over each control step (``control_dt``, 10 ms), so what a pump that
+    switches on landing gives a bounce depends on how far into a control step the ball lands. That
+    fraction is set by the body's state, but as the fractional part of a fall time of 30-50 control
+    steps, a function a small network does not form from height and velocity; here it is given. In
+    flight it stays constant (the time to landing falls by one control step per step). Like its
+    parent it keeps no state between steps."""
+
+    def __init__(self, env: gym.Env[NDArray[np.float32], NDArray[np.float32]]) -> None:
+        super().__init__(env)
+        ball = ball_env(env)
+        self.structure = ball.observation_structure
+        self.control_dt = ball.config.control_dt
+        self.gravity = ball.config.gravity
+        space = self.observation_space
+        assert isinstance(space, gym.spaces.Box), space
+        self.observation_space = gym.spaces.Box(
+            np.append(space.low, [-1.0, -1.0]).astype(np.float32),
+            np.append(space.high, [1.0, 1.0]).astype(np.float32),
+        )
+
+    def observation(self, observation: NDArray[np.float32]) -> NDArray[np.float32]:
+        phi = landing_phase(observation, self.structure, self.control_dt, self.gravity)
+        return np.append(super().observation(observation), [np.cos(phi), np.sin(phi)]).astype(np.float32)
+
+
+def landing_phase(
+    observation: NDArray[np.float32], structure: dict[str, slice], dt: float, g: float
+) -> float:
+    """Where within its control step of ``dt`` (s) the ball's centre falls to its mean radius above
+    the ground, as an angle (rad): ``phi = 2 pi frac(t / dt)`` with the ballistic time to get there
+    ``t = (v_y + sqrt(v_y^2 + 2 g (y - r))) / g`` (``y``, ``v_y``: the centre of mass's height, m,
+    and vertical velocity, m/s; ``r`` the nodes' mean distance from it, m; ``g``, m/s^2; the root
+    taken as 0 below ``r``, in contact)."""
+    nodes = observation[structure["node_position"]].reshape(-1, 2).astype(np.float64)
+    radius = float(np.sqrt((nodes**2).sum(axis=1)).mean())
+    y = float(observation[structure["centre_of_mass_position"]][1])
+    vy = float(observation[structure["centre_of_mass_velocity"]][1])
+    fall = (vy + np.sqrt(max(vy * vy + 2.0 * g * (y - radius), 0.0))) / g
+    return float(2.0 * np.pi * (fall / dt % 1.0))
+
+
+AMPLITUDE_SPAN = 0.3  # the bounce's amplitude in [-0.3, 0.3]: where the next apex answers it
+
+
+class PumpAmplitude(BallLandingObservation):
+    """The agent sets the tuned pump's amplitude once per bounce: an action ``a`` in [-1, 1] is the
+    amplitude ``u = AMPLITUDE_SPAN a``, which the pump's timing (``PressurePump.timed``: ``+u`` on
+    the ground and below its landing height, ``-u`` above) plays at every control step until the
+    first flight apex after a landing (the observation's ``last_apex`` changes) or the episode's end;
+    the agent's step is that whole bounce, its reward the sum of the env's rewards over it. It
+    observes the ball as a body with its landing phase (:class:`BallLandingObservation`, 11
+    entries). The split is the lookahead's (``agents.lookahead``): the timing scripted, each
+    bounce's amplitude chosen. Pressure mode only. An agent's step is about 70 env steps, so a
+    budget of env steps is about 70 times its ``n_timesteps``. :meth:`act` plays it one env step at
+    a time (``agents.evaluate``): it asks the model for an amplitude when a bounce starts."""
+
+    def __init__(self, env: gym.Env[NDArray[np.float32], NDArray[np.float32]]) -> None:
+        from ballenv.controllers import PressurePump
+
+        from .baselines import tuned_heuristic
+
+        super().__init__(env)
+        config = ball_env(env).config
+        if config.action_mode != "pressure":
+            raise ValueError(
+                f"PumpAmplitude: action_mode = {config.action_mode!r} is invalid: it sets the pump's "
+                "amplitude, valid: 'pressure'"
+            )
+        landing = tuned_heuristic("pressure").get("landing_height", 0.35)
+        self.pump = PressurePump(self.structure, gravity=config.gravity, landing_height=landing)
+        self.action_space = gym.spaces.Box(-1.0, 1.0, (1,), dtype=np.float32)
+        self.amplitude = 0.0
+        self.raw = np.zeros(0, dtype=np.float32)
+        self.restart()
+
+    def restart(self) -> None:
+        """A new episode: its first env step starts a bounce."""
+        self.landed = False
+        self.apex = np.nan
+        self.starting = True
+
+    def bounce_over(self, observation: NDArray[np.float32]) -> bool:
+        """Whether ``observation`` (the env's) ends the bounce: the first flight apex after a landing
+        (tracked from the observations passed in, one per env step)."""
+        if observation[self.force].sum() > 0.0:
+            self.landed = True
+        apex = float(observation[self.structure["last_apex"]][0])
+        over = self.landed and apex != self.apex
+        self.apex = apex
+        if over:
+            self.landed = False
+        return over
+
+    def reset(self, **kwargs: Any) -> tuple[NDArray[np.float32], dict[str, Any]]:
+        self.raw, info = self.env.reset(**kwargs)
+        self.restart()
+        self.bounce_over(self.raw)
+        return self.observation(self.raw), info
+
+    def step(
+        self, action: NDArray[np.float32]
+    ) -> tuple[NDArray[np.float32], SupportsFloat, bool, bool, dict[str, Any]]:
+        self.amplitude = AMPLITUDE_SPAN * float(np.clip(np.asarray(action).reshape(-1)[0], -1.0, 1.0))
+        total = 0.0
+        while True:
+            played = self.pump.timed(self.raw, self.amplitude)
+            self.raw, reward, terminated, truncated, info = self.env.step(played)
+            total += float(reward)
+            if terminated or truncated or self.bounce_over(self.raw):
+                return self.observation(self.raw), total, terminated, truncated, info
+
+    def act(self, observation: NDArray[np.float32], ask: Any) -> NDArray[np.float32]:
+        """The env's action for its ``observation``, one env step at a time: at a bounce's start a
+        new amplitude from ``ask(wrapped observation) -> action``, then the pump's timing of it."""
+        over = self.bounce_over(observation)
+        if self.starting or over:
+            action = np.asarray(ask(self.observation(observation))).reshape(-1)[0]
+            self.amplitude = AMPLITUDE_SPAN * float(np.clip(action, -1.0, 1.0))
+        self.starting = False
+        return self.pump.timed(observation, self.amplitude)
 
 
 RESIDUAL_SCALE = 0.1  # the residual's full range, in the env's action units

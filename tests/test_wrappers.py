@@ -14,10 +14,13 @@ import ballenv  # noqa: F401  (registers the env)
 from agents.baselines import HeuristicPolicy
 from agents.evaluate import evaluate
 from agents.wrappers import (
+    AMPLITUDE_SPAN,
     RESIDUAL_SCALE,
     SHAPE_MODES,
+    BallLandingObservation,
     BallShapeObservation,
     BallStateObservation,
+    PumpAmplitude,
     ResidualPump,
     radial_modes,
     wrapper_class,
@@ -116,6 +119,101 @@ def test_a_squashed_ring_shows_in_mode_two():
     assert np.abs(displacement[others]).max() < 1e-3 * 0.01 / r
 
 
+@pytest.mark.parametrize("mode", ["pressure", "paddle"])
+def test_ball_landing_adds_the_landing_phase_to_the_ball_state(mode):
+    raw = gym.make("InflatedBall-v3", action_mode=mode)
+    env = BallLandingObservation(gym.make("InflatedBall-v3", action_mode=mode))
+    assert env.observation_space.shape == ((11,) if mode == "pressure" else (14,))
+    obs, full = _into_first_contact(env, raw)
+    assert env.observation_space.contains(obs)
+    assert obs[:-2] == pytest.approx(BallStateObservation(raw).observation(full))
+    assert np.hypot(obs[-2], obs[-1]) == pytest.approx(1.0, rel=1e-6)
+
+
+def test_the_landing_phase_holds_in_flight_and_names_the_control_step_of_the_touch():
+    """Released at rest, the ball falls ballistically: its time to landing (centre at one mean radius
+    above the ground) falls by one control step per step, so the phase stays put, and the ground
+    first pushes in the control step that time ends in."""
+    raw = gym.make("InflatedBall-v3")
+    env = BallLandingObservation(gym.make("InflatedBall-v3"))
+    obs, _ = env.reset(seed=5)
+    full, _ = raw.reset(seed=5)
+    s, config = raw.unwrapped.observation_structure, raw.unwrapped.config
+    nodes = full[s["node_position"]].reshape(-1, 2)
+    height = full[s["centre_of_mass_position"]][1] - np.hypot(*nodes.T).mean()
+    steps_to_landing = np.sqrt(2.0 * height / config.gravity) / config.control_dt
+    assert 0.1 < steps_to_landing % 1.0 < 0.9  # not at a step's end, where one step either way is right
+    assert np.arctan2(obs[-1], obs[-2]) % (2 * np.pi) == pytest.approx(
+        2 * np.pi * (steps_to_landing % 1.0), abs=1e-4
+    )
+    phases, step = [], 0
+    while full[s["ground_normal_force"]].sum() == 0.0:
+        phases.append(np.arctan2(obs[-1], obs[-2]))
+        obs, *_ = env.step(np.zeros(1, dtype=np.float32))
+        full, *_ = raw.step(np.zeros(1, dtype=np.float32))
+        step += 1
+    assert np.ptp(phases) < 1e-3
+    assert step == int(np.ceil(steps_to_landing))
+
+
+def test_an_amplitude_step_is_one_bounce_of_the_pumps_timing():
+    """Each agent step plays ``+-AMPLITUDE_SPAN a`` at every env step until the first flight apex after
+    a landing: the observed last apex changes from one agent step to the next, and the rewards add."""
+    env = PumpAmplitude(gym.make("InflatedBall-v3"))
+    played, rewards, step = [], [], env.env.step
+
+    def recorded(action):
+        out = step(action)
+        played.append(float(action[0]))
+        rewards.append(float(out[1]))
+        return out
+
+    env.env.step = recorded
+    obs, _ = env.reset(seed=3)
+    apexes, total = [obs[7]], 0.0
+    for _ in range(4):
+        obs, reward, *_ = env.step(np.array([0.5], dtype=np.float32))
+        apexes.append(obs[7])
+        total += reward
+    assert set(np.round(played, 6)) == {round(0.5 * AMPLITUDE_SPAN, 6), round(-0.5 * AMPLITUDE_SPAN, 6)}
+    assert all(a != b for a, b in zip(apexes, apexes[1:], strict=False))
+    assert 4 < len(played) and total == pytest.approx(sum(rewards))
+
+
+def test_an_amplitude_played_step_by_step_is_the_stepped_episode():
+    """``act`` (what ``agents.evaluate`` calls, one env step at a time) asks for an amplitude exactly
+    where ``step`` would end an agent step, so a policy scores the same both ways."""
+    env = PumpAmplitude(gym.make("InflatedBall-v3"))
+    obs, _ = env.reset(seed=10_000)
+    stepped, decisions, done = 0.0, 0, False
+    while not done:
+        action = np.array([0.4 + 0.1 * np.tanh(obs[7])], dtype=np.float32)
+        obs, reward, terminated, truncated, _ = env.step(action)
+        stepped += float(reward)
+        decisions += 1
+        done = terminated or truncated
+    raw, player = gym.make("InflatedBall-v3"), PumpAmplitude(gym.make("InflatedBall-v3"))
+    obs, _ = raw.reset(seed=10_000)
+    player.restart()
+    asked, played, done = [], 0.0, False
+
+    def ask(wrapped):
+        asked.append(wrapped)
+        return np.array([0.4 + 0.1 * np.tanh(wrapped[7])], dtype=np.float32)
+
+    while not done:
+        obs, reward, terminated, truncated, _ = raw.step(player.act(obs, ask))
+        played += float(reward)
+        done = terminated or truncated
+    assert len(asked) == decisions
+    assert played == pytest.approx(stepped, rel=1e-12)
+
+
+def test_the_amplitude_is_for_the_pressure_mode_only():
+    with pytest.raises(ValueError, match="action_mode = 'paddle'"):
+        PumpAmplitude(gym.make("InflatedBall-v3", action_mode="paddle"))
+
+
 def test_a_wrapper_name_that_does_not_import_is_one_readable_error():
     assert wrapper_class(None) is None
     assert wrapper_class("agents.wrappers.BallStateObservation") is BallStateObservation
@@ -160,7 +258,10 @@ def test_the_residual_is_for_the_pressure_mode_only():
         ResidualPump(gym.make("InflatedBall-v3", action_mode="paddle"))
 
 
-@pytest.mark.parametrize("wrapper", ["agents.wrappers.BallStateObservation", "agents.wrappers.ResidualPump"])
+@pytest.mark.parametrize(
+    "wrapper",
+    ["agents.wrappers.BallStateObservation", "agents.wrappers.ResidualPump", "agents.wrappers.PumpAmplitude"],
+)
 def test_a_run_trained_behind_the_wrapper_is_evaluated_behind_it(tmp_path, wrapper):
     hp = {"n_steps": 64, "batch_size": 64, "n_epochs": 1, "env_wrapper": wrapper}
     command = [
