@@ -118,11 +118,14 @@ def zero_crossings(curves, amplitudes):
     return u_star, slope
 
 
+BODY_COLUMNS = list(range(len(BODY)))  # columns of features(): the body's numbers
+LANDING_COLUMNS = BODY_COLUMNS + [11, 12]  # and the landing phase (cos, sin)
 NETWORK_INPUTS = {
-    "last apex error, target, horizontal velocity, pressure": [0, 1, 2, 3],
-    "the same and the landing time within the control step (cos, sin)": [0, 1, 2, 3, 11, 12],
+    "last apex error, target, horizontal velocity, pressure": BODY_COLUMNS,
+    "the same and the landing time within the control step (cos, sin)": LANDING_COLUMNS,
     "all of the above": list(range(len(BODY) + 9)),
 }  # label -> columns of features()
+NETWORK_PUMPS = {"network pump, body": BODY_COLUMNS, "network pump, body + landing": LANDING_COLUMNS}
 FOLDS = 5
 
 
@@ -205,10 +208,7 @@ def network_pumps(episodes):
     u_star, _ = zero_crossings(curves, amplitudes)
     ok = np.isfinite(u_star)
     scores = []
-    for label, columns in (
-        ("network pump, body", [0, 1, 2, 3]),
-        ("network pump, body + landing", [0, 1, 2, 3, 11, 12]),
-    ):
+    for label, columns in NETWORK_PUMPS.items():
         predict = fit_network(rows[ok][:, columns], u_star[ok])
         pump = lambda env, p=predict, c=columns, n=label: NetworkPump(env, p, c, n)  # noqa: E731
         scores.append(evaluate(pump, KWARGS, episodes))
