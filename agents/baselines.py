@@ -4,8 +4,9 @@
 * :class:`RandomPolicy`: uniform actions in [-1, 1] from its own seeded generator;
 * :class:`HeuristicPolicy`: the scripted controller of the env's action mode
   (:class:`ballenv.controllers.PressurePump` or :class:`ballenv.controllers.PaddleDribble`);
-* :class:`agents.lookahead.LookaheadPump` ("lookahead"): the pressure mode's privileged reference,
-  the pump's timing with each bounce's amplitude found by trying amplitudes on copies of the simulator;
+* :class:`agents.lookahead.LookaheadPump` / :class:`agents.lookahead.LookaheadPaddle` ("lookahead"):
+  the privileged references, the pump's amplitude or the paddle's strike of each bounce found by
+  trying candidates on copies of the simulator;
 * :class:`ModelPolicy`: a saved Stable-Baselines3 model (deterministic actions), with the
   observation normalisation (``VecNormalize`` statistics) it was trained with.
 """
@@ -195,7 +196,7 @@ def make_policy(
     env: gym.Env[Any, Any],
     algo: str | None = None,
 ) -> Policy:
-    """``"random"``, ``"heuristic"``, ``"lookahead"`` (pressure mode's privileged reference,
+    """``"random"``, ``"heuristic"``, ``"lookahead"`` (the action mode's privileged reference,
     :mod:`agents.lookahead`), a path to a saved model / run folder, or a callable ``env -> policy``
     -> a policy."""
     if callable(spec):
@@ -205,9 +206,9 @@ def make_policy(
     if spec == "heuristic":
         return HeuristicPolicy(env)
     if spec == "lookahead":
-        from .lookahead import LookaheadPump
+        from .lookahead import LookaheadPaddle, LookaheadPump
 
-        return LookaheadPump(env)
+        return LookaheadPump(env) if ball_env(env).config.action_mode == "pressure" else LookaheadPaddle(env)
     path = pathlib.Path(spec)
     if not path.exists():
         raise ValueError(

@@ -58,6 +58,8 @@ class Score:
     episode_return: float  # mean
     apexes: float  # mean per episode, missed ones included
     episode_apex_errors: tuple[float, ...] = ()  # each episode's apex error, in seed order
+    episode_successes: tuple[int, ...] = ()  # each episode's apexes within SUCCESS_TOLERANCE
+    episode_apexes: tuple[int, ...] = ()  # each episode's apexes, missed ones included
 
 
 def run_episode(env: gym.Env[Any, Any], policy: Policy, seed: int) -> tuple[list[float], int, int, float]:
@@ -103,7 +105,7 @@ def evaluate(
     1, ...``."""
     env = gym.make(ENV_ID, **(env_kwargs or {}))
     agent = make_policy(policy, env, algo)
-    per_episode, hits, apexes, lengths, returns = [], 0, 0, [], []
+    per_episode, hits, apexes, lengths, returns = [], [], [], [], []
     seeds: Iterable[int] = range(seed, seed + episodes)
     if progress:
         from tqdm.auto import tqdm
@@ -113,8 +115,8 @@ def evaluate(
         errors, missed, length, total = run_episode(env, agent, s)
         count = len(errors) + missed
         per_episode.append((sum(errors) + missed) / count if count else 1.0)
-        hits += sum(e <= SUCCESS_TOLERANCE for e in errors)
-        apexes += count
+        hits.append(sum(e <= SUCCESS_TOLERANCE for e in errors))
+        apexes.append(count)
         lengths.append(length)
         returns.append(total)
     env.close()
@@ -125,11 +127,13 @@ def evaluate(
         episodes=episodes,
         apex_error=float(err.mean()),
         apex_error_ci95=float(half),
-        success_rate=hits / apexes if apexes else 0.0,
+        success_rate=sum(hits) / sum(apexes) if sum(apexes) else 0.0,
         episode_length=float(np.mean(lengths)),
         episode_return=float(np.mean(returns)),
-        apexes=apexes / episodes,
+        apexes=sum(apexes) / episodes,
         episode_apex_errors=tuple(float(e) for e in err),
+        episode_successes=tuple(int(h) for h in hits),
+        episode_apexes=tuple(int(a) for a in apexes),
     )
 
 

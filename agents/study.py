@@ -71,15 +71,39 @@ def bootstrap_iqm(
     return float(low), float(high)
 
 
+def bootstrap_success(
+    hits: Sequence[ArrayLike], apexes: Sequence[ArrayLike], seed: int = 0, resamples: int = RESAMPLES
+) -> tuple[float, float]:
+    """95 % percentile interval of the share of apexes within the success tolerance, per run the
+    episodes' successful apexes ``hits`` and all their apexes ``apexes``: resampled as
+    :func:`bootstrap_iqm` does (runs, then episodes within each), the share of the pooled apexes."""
+    rng = np.random.default_rng(seed)
+    pairs = [np.column_stack([h, a]).astype(float) for h, a in zip(hits, apexes, strict=True)]
+    stats = np.empty(resamples)
+    for k in range(resamples):
+        picked = rng.integers(len(pairs), size=len(pairs))
+        drawn = np.concatenate([pairs[i][rng.integers(len(pairs[i]), size=len(pairs[i]))] for i in picked])
+        stats[k] = drawn[:, 0].sum() / max(drawn[:, 1].sum(), 1.0)
+    low, high = np.percentile(stats, [2.5, 97.5])
+    return float(low), float(high)
+
+
 def summarise(name: str, scores: Sequence[Score]) -> dict[str, Any]:
-    """One table row (a dict) of ``scores``, one :class:`Score` per run."""
+    """One table row (a dict) of ``scores``, one :class:`Score` per run (the success interval is
+    None for scores stored without their episodes' apexes)."""
     runs = [s.episode_apex_errors for s in scores]
     low, high = bootstrap_iqm(runs)
+    counted = all(s.episode_apexes for s in scores)
+    success_ci = (
+        bootstrap_success([s.episode_successes for s in scores], [s.episode_apexes for s in scores])
+        if counted
+        else None
+    )
     return {
         "policy": name, "runs": len(scores), "episodes": sum(len(r) for r in runs),
         "iqm": iqm(np.concatenate(runs)), "ci": (low, high),
         "mean": float(np.mean(np.concatenate(runs))),
-        "success": float(np.mean([s.success_rate for s in scores])),
+        "success": float(np.mean([s.success_rate for s in scores])), "success_ci": success_ci,
         "return": float(np.mean([s.episode_return for s in scores])),
     }  # fmt: skip
 
@@ -87,14 +111,15 @@ def summarise(name: str, scores: Sequence[Score]) -> dict[str, Any]:
 def table(rows: Sequence[dict[str, Any]]) -> str:
     lines = [
         "| policy | runs x episodes | apex error IQM [95 % CI] | apex error mean | apexes within 5 % "
-        "| return |",
+        "[95 % CI] | return |",
         "|---|---:|---:|---:|---:|---:|",
     ]
     for r in rows:
+        ci = r.get("success_ci")
+        success = f"{100 * r['success']:.1f} %" + (f" [{100 * ci[0]:.1f}, {100 * ci[1]:.1f}]" if ci else "")
         lines.append(
             f"| {r['policy']} | {r['runs']} x {r['episodes'] // r['runs']} | {r['iqm']:.3f} "
-            f"[{r['ci'][0]:.3f}, {r['ci'][1]:.3f}] | {r['mean']:.3f} | {100 * r['success']:.1f} % | "
-            f"{r['return']:.0f} |"
+            f"[{r['ci'][0]:.3f}, {r['ci'][1]:.3f}] | {r['mean']:.3f} | {success} | {r['return']:.0f} |"
         )
     return "\n".join(lines)
 
@@ -155,10 +180,11 @@ def train_seed(job: SeedJob) -> pathlib.Path:
 
 def heldout_score(job: SeedJob, run: pathlib.Path) -> Score:
     """The best model of ``run`` on ``job.episodes`` held-out episodes: the training's final
-    evaluation (``scores.json``) if it has that many, else a new one kept in ``heldout_{n}.json``
+    evaluation (``scores.json``) if it has that many and its episodes' apex counts, else a new one
+    kept in ``heldout_{n}.json``
     (the same episodes, seeds 10,000 on: a longer evaluation extends the shorter one)."""
     stored = Score(**json.loads((run / "scores.json").read_text())[0])
-    if stored.episodes == job.episodes:
+    if stored.episodes == job.episodes and stored.episode_apexes:  # (a score without them: scored again)
         return stored
     path = run / f"heldout_{job.episodes}.json"
     if not path.exists():
@@ -212,7 +238,7 @@ def plot(
     ax.fill_between(steps[:n], returns.min(axis=0), returns.max(axis=0), alpha=0.2)
     for row, color in zip(baselines, ("tab:green", "tab:red"), strict=False):
         ax.axhline(row["return"], color=color, ls="--", label=f"{row['policy']} (held-out)")
-    ax.set_xlabel("env steps")
+    ax.set_xlabel("training steps (env steps; bounces behind a bounce-level task)")
     ax.set_ylabel("episode return (periodic evaluation)")
     ax.set_title(title)
     ax.legend(fontsize=8)

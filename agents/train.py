@@ -3,10 +3,14 @@
     python train.py --algo ppo --action-mode pressure            # the README's main command
     python train.py --algo sac --action-mode paddle --total-timesteps 50000 --seed 3
     ballenv-train --algo ppo --env-kwargs '{"fidelity": "balanced"}' --n-envs 2   # when installed
+    python train.py --algo ppo --action-mode paddle --demonstrations runs/demonstrations_paddle.npz \
+        --hyperparams '{"env_wrapper": "agents.wrappers.PaddleStrike", ...}'  # cloned, then PPO
 
 Hyperparameters come from ``agents/hyperparams/{algo}.yml`` (one entry per env id, i.e. per action
-mode; the command line overrides the budget, the number of envs and the env keyword arguments). A run writes
-one folder ``{log_dir}/{algo}_{mode}_seed{seed}[_k]`` holding:
+mode; the command line overrides the budget, the number of envs and the env keyword arguments).
+``--demonstrations`` pretrains a PPO policy on the privileged lookahead's demonstrations of a
+bounce-level task (``agents.imitation``) and evaluates it before the first update, so the best
+model may be the clone itself. A run writes one folder ``{log_dir}/{algo}_{mode}_seed{seed}[_k]`` holding:
 
 * ``config.yml`` (algorithm, hyperparameters, env keyword arguments, seed, versions) and
   ``command.txt`` (the exact command);
@@ -43,6 +47,7 @@ if TYPE_CHECKING:
     from stable_baselines3.common.vec_env import VecEnv
 
     from .evaluate import Score
+    from .imitation import Demonstrations
 
 HYPERPARAMS = pathlib.Path(__file__).parent / "hyperparams"
 ROOT = pathlib.Path(__file__).resolve().parent.parent  # holds agents/: on a Ray worker's PYTHONPATH
@@ -75,6 +80,11 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
         "--final-episodes", type=int, default=10, help="held-out episodes of the final scores (0: none)"
     )
     p.add_argument("--log-dir", default="runs", help="parent folder of the run folder")
+    p.add_argument(
+        "--demonstrations", default=None, metavar="FILE",
+        help="pretrain the policy on these lookahead demonstrations (python -m agents.imitation) "
+        "before learning; PPO behind the bounce-level task they were recorded in",
+    )  # fmt: skip
     p.add_argument("--no-baselines", action="store_true", help="score only the trained agent at the end")
     return p.parse_args(argv)
 
@@ -198,8 +208,21 @@ def callbacks(
     n_envs: int,
     total: int,
     on_evaluation: OnEvaluation | None = None,
+    evaluate_at_start: bool = False,
 ) -> list[BaseCallback]:
+    """The periodic evaluation (keeping the best model; with ``evaluate_at_start``, of the policy
+    the training starts from too: a pretrained one), checkpoints and a progress bar."""
     from stable_baselines3.common.callbacks import BaseCallback, CheckpointCallback, EvalCallback
+
+    class Evaluation(EvalCallback):
+        """Stable-Baselines3's periodic evaluation, also before the first update if ``at_start``."""
+
+        at_start = evaluate_at_start
+
+        def _on_training_start(self) -> None:
+            super()._on_training_start()
+            if self.at_start:  # n_calls is 0, a multiple of eval_freq: _on_step evaluates
+                self._on_step()
 
     class SaveNormalization(BaseCallback):
         """Save the VecNormalize statistics with each new best model."""
@@ -240,7 +263,7 @@ def callbacks(
             return bool(self.report(self.num_timesteps, float(self.parent.last_mean_reward)))
 
     every = max(args.eval_freq // n_envs, 1)
-    evaluation = EvalCallback(
+    evaluation = Evaluation(
         eval_env, best_model_save_path=str(run), log_path=str(run), eval_freq=every,
         n_eval_episodes=args.eval_episodes, deterministic=True, callback_on_new_best=SaveNormalization(),
         callback_after_eval=None if on_evaluation is None else AfterEvaluation(on_evaluation), verbose=0,
@@ -302,6 +325,30 @@ def schedules(algo_kwargs: Mapping[str, Any]) -> dict[str, Any]:
     return out
 
 
+def load_demonstrations(args: argparse.Namespace, wrapper: str | None) -> Demonstrations | None:
+    """The demonstrations of ``args.demonstrations`` (None if not given); a :class:`UsageError` if
+    the file does not load or the run is not PPO behind their task's wrapper."""
+    if args.demonstrations is None:
+        return None
+    from .imitation import TASKS, WRAPPERS, Demonstrations
+
+    if args.algo != "ppo" or wrapper not in WRAPPERS or TASKS[wrapper] != args.action_mode:
+        raise UsageError(
+            f"--demonstrations needs --algo ppo and an env_wrapper of its --action-mode among {TASKS}; "
+            f"got {args.algo}, {args.action_mode}, {wrapper}"
+        )
+    try:
+        demonstrations = Demonstrations.load(args.demonstrations)
+    except (OSError, ValueError, KeyError) as err:
+        raise UsageError(f"--demonstrations = {args.demonstrations!r}: {err}") from None
+    if demonstrations.wrapper != wrapper:
+        raise UsageError(
+            f"--demonstrations = {args.demonstrations!r} are behind {demonstrations.wrapper}, the run "
+            f"behind {wrapper} (python -m agents.imitation --wrapper {wrapper})"
+        )
+    return demonstrations
+
+
 def main(argv: Sequence[str] | None = None) -> None:
     """``python train.py ...`` / ``ballenv-train ...``: train, save and score (see the module doc)."""
     try:
@@ -339,6 +386,7 @@ def train(args: argparse.Namespace, on_evaluation: OnEvaluation | None = None) -
     except ValueError as err:
         raise UsageError(str(err)) from None
     gamma = float(algo_kwargs.get("gamma", 0.99))
+    demonstrations = load_demonstrations(args, wrapper)
 
     made_log_dir = not pathlib.Path(args.log_dir).exists()
     run = run_folder(args.log_dir, args.algo, args.action_mode, args.seed)
@@ -347,7 +395,7 @@ def train(args: argparse.Namespace, on_evaluation: OnEvaluation | None = None) -
         "total_timesteps": total, "n_envs": n_envs, "normalize": normalize,
         "policy": hp.get("policy", "MlpPolicy"), "env_wrapper": wrapper,
         "hyperparams": algo_kwargs, "eval_freq": args.eval_freq, "eval_episodes": args.eval_episodes,
-        "vec_env": args.vec_env,
+        "vec_env": args.vec_env, "demonstrations": args.demonstrations,
         "versions": {"stable_baselines3": str(stable_baselines3.__version__),
                      "torch": str(torch.__version__)},
     }  # fmt: skip
@@ -369,8 +417,16 @@ def train(args: argparse.Namespace, on_evaluation: OnEvaluation | None = None) -
             verbose=0, **model_kwargs,
         )  # fmt: skip
         opened.pop_all()  # set up: the envs stay open for the training
+    if demonstrations is not None:
+        from .imitation import pretrain
+
+        fit = pretrain(model, envs, demonstrations)
+        action, value = fit["action_mse"], fit["value_mse"]
+        print(f"pretrained on {len(demonstrations.actions)} demonstrated bounces: held-back mean "
+              f"squared error of the action {action:.2e}, of the value {value:.2e}")  # fmt: skip
     start = time.perf_counter()
-    model.learn(total_timesteps=total, callback=callbacks(run, eval_env, args, n_envs, total, on_evaluation))
+    steps = callbacks(run, eval_env, args, n_envs, total, on_evaluation, demonstrations is not None)
+    model.learn(total_timesteps=total, callback=steps)
     wall = time.perf_counter() - start
     model.save(run / "model")
     if isinstance(envs, VecNormalize):  # normalize

@@ -37,7 +37,8 @@ sys.path.insert(0, str(ROOT))
 
 import ballenv  # noqa: E402, F401  (registers the env)
 from agents.evaluate import DEFAULT_SEED, evaluate  # noqa: E402
-from agents.lookahead import LookaheadPump  # noqa: E402
+from agents.imitation import regress  # noqa: E402
+from agents.lookahead import LookaheadPump, zero_crossing  # noqa: E402
 from agents.study import summarise, table  # noqa: E402
 from agents.wrappers import landing_phase  # noqa: E402
 
@@ -105,16 +106,9 @@ def decisions(episodes, seed=DEFAULT_SEED):
 
 
 def zero_crossings(curves, amplitudes):
-    """Per decision: the amplitude where the response first crosses zero upwards and the slope
-    there (over three candidates each side); NaN where it does not cross."""
-    u_star, slope = np.full(len(curves), np.nan), np.full(len(curves), np.nan)
-    for n, c in enumerate(curves):
-        up = np.flatnonzero((c[:-1] < 0) & (c[1:] >= 0))
-        if up.size:
-            i = up[0]
-            u_star[n] = amplitudes[i] - c[i] * (amplitudes[i + 1] - amplitudes[i]) / (c[i + 1] - c[i])
-            lo, hi = max(i - 2, 0), min(i + 3, len(c) - 1)
-            slope[n] = (c[hi] - c[lo]) / (amplitudes[hi] - amplitudes[lo])
+    """Per decision: ``agents.lookahead.zero_crossing`` of its response (u*, slope; NaN where it
+    does not cross)."""
+    u_star, slope = np.array([zero_crossing(c, amplitudes) for c in curves]).T
     return u_star, slope
 
 
@@ -130,36 +124,22 @@ FOLDS = 5
 
 
 def fit_network(x, y, seed=0):
-    """A 64-64 tanh network fitted to ``y`` (n,) from ``x`` (n, k), both standardised here: Adam
-    (learning rate 1e-3, weight decay 1e-4) on the full batch, stopped where the mean squared error
-    of a sixth of the samples held back has not improved for 200 epochs (at most 3,000). Returns
-    ``predict(x) -> y``."""
+    """A 64-64 tanh network fitted to ``y`` (n,) from ``x`` (n, k), both standardised here, by
+    ``agents.imitation.regress`` (full-batch Adam, learning rate 1e-3, weight decay 1e-4, stopped
+    early on a sixth of the samples held back). Returns ``predict(x) -> y``."""
     import torch
 
     torch.manual_seed(seed)
     x_mean, x_sd, y_mean, y_sd = x.mean(axis=0), x.std(axis=0) + 1e-12, y.mean(), y.std()
     inputs = torch.tensor((x - x_mean) / x_sd, dtype=torch.float32)
     targets = torch.tensor((y - y_mean) / y_sd, dtype=torch.float32)[:, None]
-    order = np.random.default_rng(seed).permutation(len(y))
-    held, train = order[: len(y) // 6], order[len(y) // 6 :]
     net = torch.nn.Sequential(
         torch.nn.Linear(x.shape[1], 64), torch.nn.Tanh(), torch.nn.Linear(64, 64), torch.nn.Tanh(),
         torch.nn.Linear(64, 1),
     )  # fmt: skip
-    optimiser = torch.optim.Adam(net.parameters(), lr=1e-3, weight_decay=1e-4)
-    best, best_state, waited = np.inf, None, 0
-    for _ in range(3000):
-        optimiser.zero_grad()
-        loss = ((net(inputs[train]) - targets[train]) ** 2).mean()
-        loss.backward()
-        optimiser.step()
-        with torch.no_grad():
-            held_loss = float(((net(inputs[held]) - targets[held]) ** 2).mean())
-        if held_loss < best:
-            best, best_state, waited = held_loss, {k: t.clone() for k, t in net.state_dict().items()}, 0
-        elif (waited := waited + 1) > 200:
-            break
-    net.load_state_dict(best_state)
+    regress(
+        list(net.parameters()), lambda rows: ((net(inputs[rows]) - targets[rows]) ** 2).mean(), len(y), seed
+    )
 
     def predict(z):
         with torch.no_grad():

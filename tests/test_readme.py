@@ -4,7 +4,7 @@ or checked.
 Python blocks run, in order, in one namespace per file (a later block may use an earlier one's
 names), in a temporary folder. Each command of a shell block is checked without running it:
 ``make X`` is a target of the Makefile (``make -n``); ``python train.py`` and ``python -m
-agents.evaluate`` / ``study`` / ``tune`` parse with those modules' own argument parsers; ``pip
+agents.evaluate`` / ``study`` / ``tune`` / ``imitation`` parse with those modules' own argument parsers; ``pip
 install`` names a constraints file and extras that exist. A block of another language, or a
 command no check knows, fails: a new block needs a check here, or an entry in ``EXEMPT`` with
 the reason.
@@ -67,6 +67,12 @@ def check_evaluate(args):
     build_parser().parse_args(args)
 
 
+def check_imitation(args):
+    from agents.imitation import parse_args
+
+    parse_args(args)
+
+
 def check_study_or_tune(module):
     def check(args):
         from agents.train import parse_args
@@ -109,6 +115,7 @@ def checker(argv):
         ("python", "-m", "agents.evaluate"): check_evaluate,
         ("python", "-m", "agents.study"): check_study_or_tune(agents.study),
         ("python", "-m", "agents.tune"): check_study_or_tune(agents.tune),
+        ("python", "-m", "agents.imitation"): check_imitation,
         ("pip", "install"): check_pip_install,
     }
     for prefix, check in prefixes.items():

@@ -6,7 +6,7 @@ import json
 import numpy as np
 import pytest
 
-from agents.study import bootstrap_iqm, build_parser, iqm, main, train_seeds
+from agents.study import bootstrap_iqm, bootstrap_success, build_parser, iqm, main, train_seeds
 
 SHORT = {"max_episode_steps": 60}
 
@@ -30,6 +30,17 @@ def test_the_interval_counts_the_spread_between_runs():
     assert low < 0.5 < high and 0.0 <= low and high <= 1.0
 
 
+def test_the_success_interval_pools_apexes_and_counts_the_spread_between_runs():
+    """A run whose every apex succeeds and one whose none does: [0, 1] as for the IQM; episodes of
+    one rate give that rate; the pooled share weighs an episode by its apexes."""
+    assert bootstrap_success([[4, 4], [0, 0]], [[4, 4], [4, 4]]) == (0.0, 1.0)
+    assert bootstrap_success([[3] * 10], [[4] * 10]) == pytest.approx((0.75, 0.75))
+    low, high = bootstrap_success([[1, 9] * 10] * 3, [[10, 10] * 10] * 3)
+    assert low < 0.5 < high
+    low, high = bootstrap_success([[0, 18] * 10], [[2, 18] * 10])  # pooled 0.9, per-episode mean 0.5
+    assert 0.5 < low <= 0.9 <= high <= 1.0  # around the pooled share, not the episodes' mean
+
+
 def test_a_tiny_study_runs_end_to_end(tmp_path, capsys):
     argv = [
         "--seeds", "0", "1", "--episodes", "2", "--out", str(tmp_path), "--env-kwargs", json.dumps(SHORT),
@@ -42,6 +53,7 @@ def test_a_tiny_study_runs_end_to_end(tmp_path, capsys):
     assert rows[0]["runs"] == 2 and rows[0]["episodes"] == 4 and rows[1]["episodes"] == 2
     for r in rows:
         assert r["ci"][0] <= r["iqm"] <= r["ci"][1]
+        assert r["success_ci"][0] <= r["success"] <= r["success_ci"][1]
     assert (tmp_path / "ppo_pressure.png").stat().st_size > 0
     assert "apex error IQM" in (tmp_path / "ppo_pressure.md").read_text()
     assert "apex error IQM" in capsys.readouterr().out

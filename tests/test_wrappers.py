@@ -17,12 +17,17 @@ from agents.wrappers import (
     AMPLITUDE_SPAN,
     RESIDUAL_SCALE,
     SHAPE_MODES,
+    STRIKE_CORRECTION,
     BallLandingObservation,
     BallShapeObservation,
     BallStateObservation,
+    PaddleStrike,
     PumpAmplitude,
+    PumpApex,
     ResidualPump,
     radial_modes,
+    ring_angle,
+    rotation_phase,
     wrapper_class,
 )
 
@@ -180,6 +185,30 @@ def test_an_amplitude_step_is_one_bounce_of_the_pumps_timing():
     assert 4 < len(played) and total == pytest.approx(sum(rewards))
 
 
+def test_the_apex_reward_is_the_tolerance_of_the_apex_each_bounce_ends_in():
+    """PumpApex plays the bounces PumpAmplitude plays; its reward is the tolerance of each bounce's
+    apex error with the success tolerance as margin (bounded by 1), and the time limit's cut bounce
+    gets the same tolerance of the apex the env's last reward rates."""
+    from ballenv.envs.batch import height_reward
+
+    apex_env = PumpApex(gym.make("InflatedBall-v3", max_episode_steps=300))
+    sum_env = PumpAmplitude(gym.make("InflatedBall-v3", max_episode_steps=300))
+    apex_env.reset(seed=4)
+    sum_env.reset(seed=4)
+    truncated, action = False, np.array([0.5], dtype=np.float32)
+    while not truncated:
+        obs, reward, terminated, truncated, info = apex_env.step(action)
+        same, total, *_ = sum_env.step(action)
+        np.testing.assert_array_equal(obs, same)
+        assert not terminated and 0.0 <= reward <= 1.0 < total
+        if not truncated:
+            error = abs(info["apex_height"] - info["target_height"]) / info["target_height"]
+            assert reward == pytest.approx(height_reward(error, 0.05), rel=1e-12)
+    # cut short: the error the env's last reward rates (margin 0.5), rated with margin 0.05
+    error = 0.5 * np.sqrt(-2.0 * np.log(info["reward_height"])) / np.sqrt(2.0 * np.log(10.0))
+    assert reward == pytest.approx(height_reward(error, 0.05), rel=1e-9)
+
+
 def test_an_amplitude_played_step_by_step_is_the_stepped_episode():
     """``act`` (what ``agents.evaluate`` calls, one env step at a time) asks for an amplitude exactly
     where ``step`` would end an agent step, so a policy scores the same both ways."""
@@ -311,3 +340,97 @@ def test_a_mistyped_wrapper_stops_train_before_any_run_folder(tmp_path):
             ["--log-dir", str(tmp_path), "--hyperparams", json.dumps({"env_wrapper": "agents.wrappers.Nope"})]
         )
     assert not any(tmp_path.iterdir())
+
+
+def test_the_rotation_phase_predicts_where_the_nodes_sit_at_the_touch():
+    """From a strike's observation, the landing rotation phase is the ring's phase (node spacings)
+    at its first observed ground contact, to 0.03 spacings (the ring rolls a little within the
+    10-ms step the touch falls in)."""
+    env = gym.make("InflatedBall-v3", action_mode="paddle")
+    ball = env.unwrapped
+    s, g, policy = ball.observation_structure, ball.config.gravity, HeuristicPolicy(env)
+    obs, _ = env.reset(seed=3)
+    policy.reset(3)
+    predicted, found = None, []
+    for _ in range(400):
+        obs, *_ = env.step(policy.act(obs))
+        if obs[s["paddle_impulse"]][0] > 0.0:
+            predicted = rotation_phase(obs, s, g)
+        if predicted is not None and obs[s["ground_normal_force"]].sum() > 0.0:
+            nodes = obs[s["node_position"]].reshape(-1, 2).astype(np.float64)
+            found.append(
+                ((len(nodes) * ring_angle(nodes) / (2.0 * np.pi)) % 1.0 - predicted + 0.5) % 1.0 - 0.5
+            )
+            predicted = None
+    assert len(found) >= 5 and np.abs(found).max() < 0.03, found
+
+
+def test_a_strike_step_corrects_the_scripted_strike_once_and_is_rewarded_by_its_bounce():
+    """A reset plays idle until the ball is in reach; each agent step strikes ``b + 0.1 a`` (``b``
+    the scripted paddle's strike, observed last) at its first env step, idle (-1) at the others, and
+    ends when the ball is in reach again; its reward is the tolerance of the first apex after the
+    strike (margin 0.05)."""
+    from ballenv.envs.batch import height_reward
+
+    env = PaddleStrike(gym.make("InflatedBall-v3", action_mode="paddle"))
+    played, apexes, step = [], [], env.env.step
+
+    def recorded(action):
+        out = step(action)
+        played.append(float(action[0]))
+        if out[4]["apex_count"]:
+            apexes.append((len(played), out[4]["apex_height"], out[4]["target_height"]))
+        return out
+
+    env.env.step = recorded
+    obs, _ = env.reset(seed=3)
+    assert obs.shape == env.observation_space.shape == (26,) and obs[9] == 1.0  # in reach
+    for k in range(4):
+        start, base, action = len(played), env.base, 0.2 + 0.2 * k  # a strike, also where b = -1
+        assert obs[-1] == np.float32(base) and -1.0 <= base < 0.5  # -1: the ball high, no strike
+        obs, reward, terminated, truncated, _ = env.step(np.array([action], dtype=np.float32))
+        assert not (terminated or truncated) and obs[9] == 1.0  # in reach again
+        assert played[start] == pytest.approx(base + STRIKE_CORRECTION * action, abs=1e-6)
+        assert set(played[start + 1 :]) == {-1.0}  # idle until the next decision
+        first = next((h, t) for n, h, t in apexes if n > start)
+        assert reward == pytest.approx(height_reward(abs(first[0] - first[1]) / first[1], 0.05), rel=1e-12)
+
+
+def test_a_strike_played_step_by_step_is_the_stepped_episode():
+    """``act`` asks for a correction exactly where ``step`` would end an agent step (and the reset's
+    first), and plays the same env actions, so a policy scores the same both ways."""
+
+    def policy(wrapped):
+        return np.array([-0.2 + 0.2 * np.tanh(wrapped[7] - wrapped[6])], dtype=np.float32)
+
+    env = PaddleStrike(gym.make("InflatedBall-v3", action_mode="paddle", max_episode_steps=400))
+    stepped, step = [], env.env.step
+    env.env.step = lambda action: (stepped.append(float(action[0])), step(action))[1]
+    obs, _ = env.reset(seed=10_000)
+    decisions, done = 0, False
+    while not done:
+        obs, _, terminated, truncated, _ = env.step(policy(obs))
+        decisions += 1
+        done = terminated or truncated
+    raw = gym.make("InflatedBall-v3", action_mode="paddle", max_episode_steps=400)
+    player = PaddleStrike(gym.make("InflatedBall-v3", action_mode="paddle"))
+    obs, _ = raw.reset(seed=10_000)
+    player.restart()
+    asked, played, done = [], [], False
+
+    def ask(wrapped):
+        asked.append(wrapped)
+        return policy(wrapped)
+
+    while not done:
+        action = player.act(obs, ask)
+        played.append(float(action[0]))
+        obs, _, terminated, truncated, _ = raw.step(action)
+        done = terminated or truncated
+    assert len(asked) == decisions >= 5
+    assert played == stepped
+
+
+def test_the_strike_is_for_the_paddle_mode_only():
+    with pytest.raises(ValueError, match="action_mode = 'pressure' is invalid: it corrects the paddle's"):
+        PaddleStrike(gym.make("InflatedBall-v3"))
