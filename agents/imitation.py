@@ -2,8 +2,8 @@
 Stable-Baselines3 PPO policy pretrained on them before reinforcement learning.
 
     python -m agents.imitation --wrapper agents.wrappers.PumpApex --out runs/demonstrations_pump.npz
-    python train.py --algo ppo --action-mode pressure --demonstrations runs/demonstrations_pump.npz \
-        --hyperparams '{"env_wrapper": "agents.wrappers.PumpApex", ...}'   # see docs/training.md
+    python train.py --algo ppo --action-mode pressure --conf-file ppo_cloned \
+        --demonstrations runs/demonstrations_pump.npz   # agents/hyperparams/ppo_cloned.yml
 
 The tasks (``TASKS``) take one action per bounce: :class:`agents.wrappers.PumpApex` (or
 ``PumpAmplitude``, the same task summing the env's rewards) the pump's amplitude ``u =

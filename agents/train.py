@@ -3,11 +3,12 @@
     python train.py --algo ppo --action-mode pressure            # the README's main command
     python train.py --algo sac --action-mode paddle --total-timesteps 50000 --seed 3
     ballenv-train --algo ppo --env-kwargs '{"fidelity": "balanced"}' --n-envs 2   # when installed
-    python train.py --algo ppo --action-mode paddle --demonstrations runs/demonstrations_paddle.npz \
-        --hyperparams '{"env_wrapper": "agents.wrappers.PaddleStrike", ...}'  # cloned, then PPO
+    python train.py --algo ppo --action-mode paddle --conf-file ppo_cloned \
+        --demonstrations runs/demonstrations_paddle.npz                   # cloned, then PPO
 
-Hyperparameters come from ``agents/hyperparams/{algo}.yml`` (one entry per env id, i.e. per action
-mode; the command line overrides the budget, the number of envs and the env keyword arguments).
+Hyperparameters come from ``agents/hyperparams/{algo}.yml``, or ``--conf-file`` (one entry per env
+id, i.e. per action mode; the command line overrides the budget, the number of envs and the env
+keyword arguments).
 ``--demonstrations`` pretrains a PPO policy on the privileged lookahead's demonstrations of a
 bounce-level task (``agents.imitation``) and evaluates it before the first update, so the best
 model may be the clone itself. A run writes one folder ``{log_dir}/{algo}_{mode}_seed{seed}[_k]`` holding:
@@ -65,6 +66,11 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
     )
     p.add_argument("--env-kwargs", type=parse_env_kwargs, default=None, help="JSON object of env keywords")
     p.add_argument(
+        "--conf-file", default=None, metavar="FILE",
+        help="hyperparameters in RL Zoo's YAML format instead of agents/hyperparams/{algo}.yml: a path, or "
+        "the name of a file there (e.g. ppo_cloned)",
+    )  # fmt: skip
+    p.add_argument(
         "--hyperparams", type=parse_env_kwargs, default=None, help="JSON object overriding the YAML"
     )
     p.add_argument("--n-envs", type=int, default=None, help="parallel envs (default: from the YAML)")
@@ -118,11 +124,22 @@ def env_id(mode: str) -> str:
     return f"ballenv:{ENV_IDS[mode]}"
 
 
-def load_hyperparams(algo: str, mode: str) -> dict[str, Any]:
-    """The YAML entry of ``algo`` for the env id of action mode ``mode`` (a dict)."""
+def load_hyperparams(algo: str, mode: str, conf_file: str | None = None) -> dict[str, Any]:
+    """The YAML entry for the env id of action mode ``mode`` (a dict) in ``conf_file`` (a path, or
+    the name of a file in ``agents/hyperparams`` without ``.yml``; default: ``algo``'s file); a
+    :class:`UsageError` if there is no such file or entry."""
     from ballenv.envs import ENV_IDS
 
-    table = yaml.safe_load((HYPERPARAMS / f"{algo}.yml").read_text())
+    path = HYPERPARAMS / f"{algo}.yml"
+    if conf_file is not None:
+        given = pathlib.Path(conf_file)
+        path = given if given.suffix in (".yml", ".yaml") else HYPERPARAMS / f"{conf_file}.yml"
+        if not path.exists():
+            names = sorted(f.stem for f in HYPERPARAMS.glob("*.yml"))
+            raise UsageError(f"--conf-file = {conf_file!r}: no such file (the project's: {names})")
+    table = yaml.safe_load(path.read_text()) or {}
+    if ENV_IDS[mode] not in table:
+        raise UsageError(f"{path} has no entry for {ENV_IDS[mode]} (--action-mode {mode}): {sorted(table)}")
     return dict(table[ENV_IDS[mode]])
 
 
@@ -369,7 +386,7 @@ def train(args: argparse.Namespace, on_evaluation: OnEvaluation | None = None) -
 
     from .wrappers import wrapper_class
 
-    hp = load_hyperparams(args.algo, args.action_mode)
+    hp = load_hyperparams(args.algo, args.action_mode, args.conf_file)
     hp.update(args.hyperparams or {})
     env_kwargs = task_env_kwargs(args.algo, args.action_mode, args.env_kwargs, entry=hp)
     n_envs = args.n_envs or int(hp.get("n_envs", 1))

@@ -315,8 +315,8 @@ def rotation_phase(
     centre of mass's) and ``t = (v + sqrt(v^2 + 2 g (y - r))) / g`` the ballistic time (s) until
     the centre of mass (height ``y``, vertical velocity ``v = v_y - push``: ``push`` (m/s) a strike
     about to push it down) falls to the nodes' mean distance ``r`` from it above the ground (0 in
-    contact). A 32-gon's bounce depends on it: up to 10 % of
-    the rise over half a node spacing (``benchmarks/bounce_phase.py``)."""
+    contact). A 32-gon's bounce depends on it: up to 10 % of the rise over half a node spacing
+    (``benchmarks/bounce_phase.py``)."""
     nodes = observation[structure["node_position"]].reshape(-1, 2).astype(np.float64)
     y = float(observation[structure["centre_of_mass_position"]][1])
     vy = float(observation[structure["centre_of_mass_velocity"]][1]) - push
@@ -331,8 +331,9 @@ class BallRotationObservation(BallStateObservation):
     next lands: ``cos 2 pi k q`` and ``sin 2 pi k q`` of :func:`rotation_phase` ``q`` for ``k = 1 ..
     ROTATION_HARMONICS`` (15 entries in pressure mode, 18 in paddle mode). What a 32-node ring's
     bounce depends on beyond its body's state: over the scripted paddle's strikes the next apex's
-    error scatters by 0.026, of which these harmonics leave 0.018 (``benchmarks/paddle_phase.py``).
-    Like its parent it keeps no state between steps."""
+    error scatters by 0.026, of which these harmonics, observed after the strike, leave 0.018
+    (``benchmarks/paddle_phase.py``); observed before it they miss the spin the strike gives, which
+    :class:`PaddleStrike` observes what sets. Like its parent it keeps no state between steps."""
 
     def __init__(self, env: gym.Env[NDArray[np.float32], NDArray[np.float32]]) -> None:
         super().__init__(env)

@@ -80,6 +80,26 @@ def test_a_hyperparameter_typo_is_one_readable_line_and_leaves_no_run_folder(tmp
     assert not (tmp_path / "runs").exists()
 
 
+def test_a_conf_file_is_read_by_name_or_path_and_a_missing_one_is_named(tmp_path):
+    from agents.train import load_hyperparams
+
+    cloned = load_hyperparams("ppo", "paddle", "ppo_cloned")
+    assert cloned["env_wrapper"] == "agents.wrappers.PaddleStrike" and cloned["learning_rate"] == 3e-5
+    assert load_hyperparams("ppo", "pressure", "ppo_cloned")["env_wrapper"] == "agents.wrappers.PumpApex"
+    own = tmp_path / "mine.yml"
+    own.write_text("InflatedBall-v3:\n  n_timesteps: 64\n")
+    assert load_hyperparams("ppo", "pressure", str(own)) == {"n_timesteps": 64}
+    for conf, message in ((str(tmp_path / "none.yml"), "no such file"), (str(own), "no entry for")):
+        with pytest.raises(SystemExit) as stop:
+            train_main(["--action-mode", "paddle", "--conf-file", conf, "--log-dir", str(tmp_path / "runs")])
+        assert (
+            message in str(stop.value.code)
+            and "ppo_cloned" in str(stop.value.code)
+            or message == "no entry for"
+        )
+    assert not (tmp_path / "runs").exists()
+
+
 def test_a_mistyped_policy_names_the_choices(capsys):
     choices = "must be one of \\('random', 'heuristic', 'lookahead'\\)"
     with pytest.raises(ValueError, match="policy = 'heuristc' is invalid: " + choices):
