@@ -300,10 +300,12 @@ def ring_spin(observation: NDArray[np.float32], structure: dict[str, slice]) -> 
     return float((nodes[:, 0] * velocity[:, 1] - nodes[:, 1] * velocity[:, 0]).sum() / (nodes**2).sum())
 
 
-def phase_harmonics(q: float) -> NDArray[np.float64]:
-    """``cos 2 pi k q`` and ``sin 2 pi k q`` for ``k = 1 .. ROTATION_HARMONICS``, interleaved."""
-    k = np.arange(1, ROTATION_HARMONICS + 1)
-    return np.column_stack([np.cos(2.0 * np.pi * k * q), np.sin(2.0 * np.pi * k * q)]).ravel()
+def phase_harmonics(q: float | NDArray[np.float64]) -> NDArray[np.float64]:
+    """``cos 2 pi k q`` and ``sin 2 pi k q`` for ``k = 1 .. ROTATION_HARMONICS``, interleaved along
+    the last axis (a phase ``q`` gives 6 numbers, an array of phases one row each)."""
+    angle = 2.0 * np.pi * np.asarray(q, dtype=np.float64)
+    k = range(1, ROTATION_HARMONICS + 1)
+    return np.stack([f(n * angle) for n in k for f in (np.cos, np.sin)], axis=-1)
 
 
 def rotation_phase(

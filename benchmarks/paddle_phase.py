@@ -40,7 +40,7 @@ from pump_response import FOLDS, network_residual_sd  # noqa: E402
 
 import ballenv  # noqa: E402, F401  (registers the env)
 from agents.baselines import HeuristicPolicy  # noqa: E402
-from agents.wrappers import ROTATION_HARMONICS, ring_angle, ring_spin, rotation_phase  # noqa: E402
+from agents.wrappers import phase_harmonics, ring_angle, ring_spin, rotation_phase  # noqa: E402
 from ballenv.envs import ENV_IDS  # noqa: E402
 from ballenv.physics.ring import total_mass  # noqa: E402
 
@@ -94,13 +94,6 @@ def strikes(episodes, seed=0):
     return dict(zip(COLUMNS, np.array(rows).T, strict=True))
 
 
-def harmonics(q):
-    """The landing phase's first ``ROTATION_HARMONICS`` harmonics, ``cos 2 pi k q`` and ``sin 2 pi k q``."""
-    return np.column_stack(
-        [f(2.0 * math.pi * k * q) for k in range(1, ROTATION_HARMONICS + 1) for f in (np.cos, np.sin)]
-    )
-
-
 def linear_residual_sd(y, x):
     """Standard deviation of ``y`` left out of sample by least squares on ``x`` (and a constant),
     over the same ``FOLDS`` random parts as :func:`pump_response.network_residual_sd`."""
@@ -120,8 +113,8 @@ def main():
     args = p.parse_args()
     data = strikes(args.episodes)
     body, error = np.column_stack([data[name] for name in BODY]), data["error"]
-    after, before = harmonics(data["phase after"]), harmonics(data["phase before"])
-    decided = np.column_stack([body, before, harmonics(data["phase now"]), data["spin"]])
+    after, before = phase_harmonics(data["phase after"]), phase_harmonics(data["phase before"])
+    decided = np.column_stack([body, before, phase_harmonics(data["phase now"]), data["spin"]])
     body_after, body_before = np.column_stack([body, after]), np.column_stack([body, before])
     rows = [
         ("none (the scatter itself)", float(error.std())),

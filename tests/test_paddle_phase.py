@@ -12,7 +12,7 @@ def test_the_fits_find_a_known_dependence_on_the_phase_and_nothing_in_noise():
     q = rng.uniform(0.0, 1.0, 2000)
     noise = rng.normal(0.0, 0.01, 2000)
     error = 0.02 * np.cos(2.0 * np.pi * q + 0.3) - 0.01 * np.sin(6.0 * np.pi * q) + noise
-    left = paddle_phase.linear_residual_sd(error, paddle_phase.harmonics(q))
+    left = paddle_phase.linear_residual_sd(error, paddle_phase.phase_harmonics(q))
     assert abs(left - 0.01) < 0.0006  # the noise only
     unrelated = rng.normal(size=(2000, 3))
     assert paddle_phase.linear_residual_sd(error, unrelated) > 0.99 * error.std()
