@@ -11,15 +11,15 @@ AMPLITUDE_SPAN a`` in the pressure mode, :class:`agents.wrappers.PaddleStrike` a
 scripted paddle's strike in the paddle mode. At each of the task's decisions the mode's lookahead
 (:class:`agents.lookahead.LookaheadPump`, :class:`agents.lookahead.LookaheadPaddle`) tries 41
 candidates on copies of the simulator (around what the agent's zero action plays, the wrapper's
-``base``); the demonstration's action is the candidate where the next apex's signed error crosses
-zero (the pump: :func:`agents.lookahead.zero_crossing`, linear between the two candidates around
-it; the paddle, whose bounce scatters between nearby strikes: where the least-squares line through
-the errors does, :func:`agents.lookahead.trend_crossing`), or the best candidate where none
-crosses, as the agent's action (the wrapper's ``action_for``). The
+``base``); the demonstration's action is the lookahead's label (``label``) where the next apex's
+signed error crosses zero (the pump: :func:`agents.lookahead.zero_crossing`, linear between the two
+candidates around it; the paddle, whose bounce scatters between nearby strikes: where the
+least-squares line through the errors does, :func:`agents.lookahead.trend_crossing`), or the best
+candidate where none crosses, as the agent's action (the wrapper's ``action_for``). The
 demonstrator plays its actions, so the recorded states are the ones it visits. The lookahead reads
 the simulator; the policy cloned from it reads only the wrapper's observation (the ball as a body
 and, in the pressure mode, its landing phase, 11 entries; in the paddle mode its landing rotation
-phase and the scripted strike, 19 entries).
+phase, its rotation phase and spin at the strike and the scripted strike, 26 entries).
 
 :func:`pretrain` fits the policy's mean action to the demonstrations (mean squared error), its value
 to the discounted return of the demonstrator's normalised rewards (an episode cut short by the time
@@ -101,7 +101,7 @@ def record(
     from tqdm.auto import tqdm
 
     from .evaluate import ENV_ID
-    from .lookahead import Lookahead, LookaheadPaddle, LookaheadPump, trend_crossing, zero_crossing
+    from .lookahead import Lookahead, LookaheadPaddle, LookaheadPump
     from .wrappers import AMPLITUDE_SPAN, wrapper_class
 
     task = wrapper_class(wrapper) if wrapper in WRAPPERS else None
@@ -119,10 +119,7 @@ def record(
         done = False
         while not done:
             best = lookahead.plan(env.base)  # around the value the agent's zero action plays
-            if TASKS[wrapper] == "pressure":
-                crossing, _ = zero_crossing(lookahead.candidate_errors, lookahead.values)
-            else:
-                crossing = trend_crossing(lookahead.candidate_errors, lookahead.values)
+            crossing = lookahead.label()
             action = float(np.clip(env.action_for(crossing if np.isfinite(crossing) else best), -1.0, 1.0))
             next_obs, reward, terminated, truncated, _ = env.step(np.array([action], dtype=np.float32))
             done = terminated or truncated

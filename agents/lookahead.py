@@ -67,6 +67,11 @@ class Lookahead:
         """The env action of a copy observing ``obs`` that plays candidate ``value``."""
         raise NotImplementedError
 
+    def label(self) -> float:
+        """The value a policy should learn from the last plan (``agents.imitation``'s label); NaN if
+        the plan gives none (the best candidate is then played)."""
+        raise NotImplementedError
+
     def plan(self, centre: float = 0.0) -> float:
         """The value of ``centre + offsets`` whose copy's next apex after a landing is nearest the
         target (the middle candidate if no copy reaches one: the episode ends first); its error in
@@ -98,8 +103,8 @@ class Lookahead:
 
 class LookaheadPump(Lookahead):
     """The pump's timing with each bounce's amplitude chosen by one-bounce lookahead on copies of
-    the simulator's state (see the module doc): the candidates are amplitudes ``u`` in ``[-span,
-    span]`` (``amplitudes``). Pressure mode only."""
+    the simulator's state (see the module doc): the candidates (``values``) are amplitudes ``u`` in
+    ``[-span, span]``. Pressure mode only."""
 
     mode = "pressure"
 
@@ -109,7 +114,6 @@ class LookaheadPump(Lookahead):
         super().__init__(env, span, candidates, horizon)
         landing = tuned_heuristic("pressure").get("landing_height", 0.35)
         self.pump = PressurePump(self.structure, gravity=ball_env(env).config.gravity, landing_height=landing)
-        self.amplitudes = self.values
         self.amplitude: float | None = None
 
     def reset(self, seed: int) -> None:
@@ -122,6 +126,10 @@ class LookaheadPump(Lookahead):
 
     def copy_action(self, obs: NDArray[np.float32], value: float) -> float:
         return float(self.pump.timed(obs, value)[0])
+
+    def label(self) -> float:
+        """The amplitude where the candidates' apex errors first cross zero (:func:`zero_crossing`)."""
+        return zero_crossing(self.candidate_errors, self.values)[0]
 
 
 class LookaheadPaddle(Lookahead):
@@ -158,6 +166,11 @@ class LookaheadPaddle(Lookahead):
     def copy_action(self, obs: NDArray[np.float32], value: float) -> float:
         """The env's float32 action, as :meth:`act` plays it: a copy's bounce is then the env's."""
         return float(np.float32(np.clip(value, -1.0, 1.0))) if self.reaches(obs) else -1.0
+
+    def label(self) -> float:
+        """The root of the trend through the candidates' apex errors (:func:`trend_crossing`): the
+        strike the state calls for, without the bounce's scatter between neighbouring strikes."""
+        return trend_crossing(self.candidate_errors, self.values)
 
 
 def zero_crossing(curve: NDArray[np.float64], amplitudes: NDArray[np.float64]) -> tuple[float, float]:

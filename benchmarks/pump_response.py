@@ -102,7 +102,7 @@ def decisions(episodes, seed=DEFAULT_SEED):
     made = []
     score = evaluate(lambda env: made.append(RecordedLookahead(env)) or made[-1], KWARGS, episodes, seed)
     policy = made[-1]
-    return score, np.array(policy.rows), np.array(policy.curves), policy.amplitudes
+    return score, np.array(policy.rows), np.array(policy.curves), policy.values
 
 
 def zero_crossings(curves, amplitudes):
