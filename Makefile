@@ -45,6 +45,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/collision_cost.py
 	$(PY) benchmarks/work_precision.py
 	$(PY) benchmarks/env_throughput.py
+	$(PY) benchmarks/cold_start.py
 
 soak: $(STAMP)  # the stability soak (about 15 minutes), not part of test or bench
 	$(PY) benchmarks/soak.py

@@ -19,13 +19,16 @@ called by other kernels. So a kernel is compiled without them (numba's ``no_cpyt
 ``no_cfunc_wrapper``): the env's first step compiles in 32 s of CPU instead of 46 s. Called from
 Python, a kernel calls its twin (:func:`python_entry`): the same function compiled with the
 wrappers, cached under its own name (``<name>.python``), compiled only for kernels Python calls
-(``simulate``'s driver, the env's step and reset, a test).
+(``simulate``'s driver, the env's step and reset, a test). Processes that compile the same twin
+for the same argument types at once compile it once (:mod:`.compile_lock`).
 """
 
 import types
 
 from numba import njit
 from numba.core.registry import CPUDispatcher
+
+from .compile_lock import SharedCompile
 
 OPTIONS = {"cache": True, "_nrt": False}
 WRAPPERS = ("no_cpython_wrapper", "no_cfunc_wrapper")
@@ -53,6 +56,7 @@ def python_entry(dispatcher):
         g.__module__, g.__doc__, g.__kwdefaults__ = f.__module__, f.__doc__, f.__kwdefaults__
         options = {k: v for k, v in dispatcher.targetoptions.items() if k not in WRAPPERS and k != "nopython"}
         twin = dispatcher._twin = njit(cache=True, **options)(g)
+        twin.__class__ = SharedCompile  # compiled once across processes (compile_lock.py)
     return twin
 
 

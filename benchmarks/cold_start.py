@@ -1,0 +1,84 @@
+"""What the first run costs on an empty numba cache: the wall and CPU time (s) of a process that makes
+``InflatedBall-v3`` envs, resets them and takes three steps, with one env in the process and with
+``--envs`` envs in as many subprocesses (gymnasium's ``AsyncVectorEnv``, spawned), each run against a
+new cache directory (``NUMBA_CACHE_DIR``; the checkout's own cache is not touched).
+
+    python benchmarks/cold_start.py   # writes benchmarks/results/cold_start.md (about 2 min)
+
+The subprocesses compile each kernel once between them (``ballenv/physics/compile_lock.py``): the
+first to need it compiles it, the others wait and load it from the cache, so the CPU time of four
+envs stays that of one.
+"""
+
+import argparse
+import os
+import pathlib
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+
+RESULTS = pathlib.Path(__file__).parent / "results"
+
+FIRST_STEPS = """
+import sys
+import gymnasium as gym
+import ballenv  # noqa: F401  (registers the env)
+
+if __name__ == "__main__":
+    n = int(sys.argv[1])
+    if n == 1:
+        envs = gym.make("InflatedBall-v3")
+    else:
+        envs = gym.make_vec("InflatedBall-v3", num_envs=n, vectorization_mode="async",
+                            vector_kwargs={"context": "spawn"})
+    envs.reset(seed=0)
+    for _ in range(3):
+        envs.step(envs.action_space.sample())
+    envs.close()
+"""
+
+
+def cold_start(n_envs):
+    """(wall s, CPU s of the process and its subprocesses) of ``n_envs`` envs' first steps on an
+    empty numba cache."""
+    with tempfile.TemporaryDirectory() as cache:
+        env = dict(os.environ, NUMBA_CACHE_DIR=cache, OPENBLAS_NUM_THREADS="1")
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
+        start = time.perf_counter()
+        subprocess.run(
+            [sys.executable, "-c", FIRST_STEPS, str(n_envs)], env=env, check=True, capture_output=True
+        )
+        wall = time.perf_counter() - start
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return wall, cpu
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--envs", type=int, default=4, help="subprocess envs of the vector run (default 4)")
+    args = parser.parse_args()
+    rows = [(n, *cold_start(n)) for n in (1, args.envs)]
+    lines = [
+        "# Cold start: the first steps on an empty numba cache",
+        "",
+        f"`python benchmarks/cold_start.py` on {os.cpu_count()} cores: make, reset and three steps of "
+        "`InflatedBall-v3`, a new `NUMBA_CACHE_DIR` per run.",
+        "",
+        "| envs | wall (s) | CPU (s) |",
+        "|---:|---:|---:|",
+        *(
+            f"| {n} ({'one process' if n == 1 else 'AsyncVectorEnv'}) | {w:.1f} | {c:.1f} |"
+            for n, w, c in rows
+        ),
+        "",
+    ]
+    text = "\n".join(lines)
+    print(text)
+    (RESULTS / "cold_start.md").write_text(text)
+
+
+if __name__ == "__main__":
+    main()
