@@ -206,9 +206,9 @@ def make_policy(
     if spec == "heuristic":
         return HeuristicPolicy(env)
     if spec == "lookahead":
-        from .lookahead import LookaheadPaddle, LookaheadPump
+        from .lookahead import lookahead_for
 
-        return LookaheadPump(env) if ball_env(env).config.action_mode == "pressure" else LookaheadPaddle(env)
+        return lookahead_for(env)
     path = pathlib.Path(spec)
     if not path.exists():
         raise ValueError(

@@ -101,16 +101,14 @@ def record(
     from tqdm.auto import tqdm
 
     from .evaluate import ENV_ID
-    from .lookahead import Lookahead, LookaheadPaddle, LookaheadPump
-    from .wrappers import AMPLITUDE_SPAN, wrapper_class
+    from .lookahead import lookahead_for
+    from .wrappers import wrapper_class
 
     task = wrapper_class(wrapper) if wrapper in WRAPPERS else None
     if task is None:
         raise ValueError(f"wrapper = {wrapper!r} is invalid: the demonstrated tasks are {WRAPPERS}")
     env: Any = task(gym.make(ENV_ID, **{**env_kwargs, "action_mode": TASKS[wrapper]}))  # base, action_for
-    lookahead: Lookahead = (
-        LookaheadPump(env, span=AMPLITUDE_SPAN) if TASKS[wrapper] == "pressure" else LookaheadPaddle(env)
-    )
+    lookahead = lookahead_for(env)  # the pump's candidates span the task's AMPLITUDE_SPAN
     columns: dict[str, list[Any]] = {
         name: [] for name in Demonstrations.__dataclass_fields__ if name != "wrapper"
     }

@@ -27,6 +27,7 @@ from ballenv.envs.batch import BallBatch
 from ballenv.envs.inflated_ball import ball_env
 
 from .baselines import tuned_heuristic
+from .wrappers import AMPLITUDE_SPAN
 
 
 class Lookahead:
@@ -62,6 +63,14 @@ class Lookahead:
         self.expected_error = np.inf  # the apex error the last plan's copy reached
         # each candidate's signed relative error (h - h_target) / h_target in the last plan (NaN: no apex)
         self.candidate_errors = np.full(candidates, np.nan)
+
+    def reset(self, seed: int) -> None:
+        """A new episode (the ``agents.baselines.Policy`` protocol)."""
+        raise NotImplementedError
+
+    def act(self, obs: NDArray[np.float32]) -> NDArray[np.float32]:
+        """The env action for ``obs``, planning where a decision falls."""
+        raise NotImplementedError
 
     def copy_action(self, obs: NDArray[np.float32], value: float) -> float:
         """The env action of a copy observing ``obs`` that plays candidate ``value``."""
@@ -109,7 +118,7 @@ class LookaheadPump(Lookahead):
     mode = "pressure"
 
     def __init__(
-        self, env: gym.Env[Any, Any], span: float = 0.3, candidates: int = 41, horizon: int = 300
+        self, env: gym.Env[Any, Any], span: float = AMPLITUDE_SPAN, candidates: int = 41, horizon: int = 300
     ) -> None:
         super().__init__(env, span, candidates, horizon)
         landing = tuned_heuristic("pressure").get("landing_height", 0.35)
@@ -171,6 +180,12 @@ class LookaheadPaddle(Lookahead):
         """The root of the trend through the candidates' apex errors (:func:`trend_crossing`): the
         strike the state calls for, without the bounce's scatter between neighbouring strikes."""
         return trend_crossing(self.candidate_errors, self.values)
+
+
+def lookahead_for(env: gym.Env[Any, Any]) -> Lookahead:
+    """The privileged lookahead of ``env``'s action mode, with its default candidates."""
+    mode = ball_env(env).config.action_mode
+    return next(kind for kind in (LookaheadPump, LookaheadPaddle) if kind.mode == mode)(env)
 
 
 def zero_crossing(curve: NDArray[np.float64], amplitudes: NDArray[np.float64]) -> tuple[float, float]:

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import ballenv  # noqa: F401  (registers the env)
-from agents.baselines import HeuristicPolicy
+from agents.baselines import HeuristicPolicy, make_policy
 from agents.evaluate import run_episode
 from agents.lookahead import LookaheadPaddle, LookaheadPump
 
@@ -90,6 +90,12 @@ def test_lookahead_refuses_the_paddle_mode_and_bad_candidates():
         LookaheadPump(gym.make("InflatedBall-v3", action_mode="paddle"))
     with pytest.raises(ValueError, match="span = 0.3, candidates = 1 are out of range"):
         LookaheadPump(gym.make("InflatedBall-v3"), candidates=1)
+
+
+@pytest.mark.parametrize(("mode", "kind"), [("pressure", LookaheadPump), ("paddle", LookaheadPaddle)])
+def test_the_named_lookahead_is_the_action_modes(mode, kind):
+    policy = make_policy("lookahead", gym.make("InflatedBall-v3", action_mode=mode))
+    assert type(policy) is kind
 
 
 def test_the_response_analysis_finds_the_crossing_the_slope_and_an_exact_fit():
