@@ -105,28 +105,41 @@ def test_doubling_only_with_error_control_and_contact():
     assert Simulation(dataclasses.replace(doubling, contact_error="impulse")).ws.doubling is None
 
 
-def _family_errors(name, tolerances):
+def _family_errors(name, tolerances, control):
+    """Ball ``name``'s first-apex errors at each of ``tolerances`` (``rtol``) under the contact
+    control ``control``, relative to its cached reference (N = 64)."""
     reference = json.loads(REFERENCES.read_text())["64"][name]["apex"]
     errors = []
     for rtol in tolerances:
         scene = ball_family.ball_scene(
-            name, adaptive=True, dt=1e-2, rtol=rtol, rho_infinity=0.9, contact_error="doubling"
+            name, adaptive=True, dt=1e-2, rtol=rtol, rho_infinity=0.9, contact_error=control
         )
         apex, _ = ball_family.first_apex(name, scene)
         errors.append(abs(apex - reference) / reference)
     return errors
 
 
-@pytest.mark.parametrize("name", ["env", "basketball"])
-def test_error_falls_with_the_tolerance_on_the_family(name):
-    """Under ``contact_error = "doubling"``, two balls of ``benchmarks/ball_family.py`` (a light ring
-    on a slope, a heavy ball with friction) against their cached references: the first-apex error
-    falls at every tightening of ``rtol`` from 3e-2 to 1e-3 and stays below 4 ``rtol`` (the family:
-    0.06-3.5 ``rtol``, ``accuracy.py``)."""
+@pytest.mark.parametrize(
+    ("control", "name", "at_most"),
+    [
+        ("doubling", "env", 4.0),
+        ("doubling", "basketball", 4.0),
+        ("impulse", "tennis", 1.0),
+        ("impulse", "basketball", 1.0),
+        ("impulse", "env", 1.0),
+    ],
+)
+def test_error_falls_with_the_tolerance_on_the_family(control, name, at_most):
+    """Balls of ``benchmarks/ball_family.py`` against their cached references: the first-apex error
+    falls at every tightening of ``rtol`` from 3e-2 to 1e-3 and stays below ``at_most`` times ``rtol``.
+    Under "doubling", the light ring on a slope and the heavy ball with friction (the family:
+    0.06-3.5 ``rtol``, ``accuracy.py``); under "impulse" (the default), the three balls on which one
+    drop's error falls at every tightening (0.004-0.22 ``rtol``; on the bending, stiff and
+    light rings it rises once, within the error's scatter from drop to drop: docs/benchmarks.md)."""
     tolerances = (3e-2, 1e-2, 3e-3, 1e-3)
-    errors = _family_errors(name, tolerances)
+    errors = _family_errors(name, tolerances, control)
     assert all(b < a for a, b in zip(errors, errors[1:], strict=False)), errors
-    assert all(e <= 4.0 * t for e, t in zip(errors, tolerances, strict=True)), errors
+    assert all(e <= at_most * t for e, t in zip(errors, tolerances, strict=True)), errors
 
 
 def test_doubling_bound_on_the_contact_impulse():
