@@ -1,9 +1,11 @@
 """What the first run costs on an empty numba cache: the wall and CPU time (s) of a process that makes
 ``InflatedBall-v3`` envs, resets them and takes three steps, with one env in the process and with
-``--envs`` envs in as many subprocesses (gymnasium's ``AsyncVectorEnv``, spawned), each run against a
+``--envs`` envs in as many subprocesses (gymnasium's ``AsyncVectorEnv``, spawned), and of a process
+whose first ``simulate()`` runs ``Scene``'s defaults (the self-contact barrier, error control) with
+one ring and with two (the joint step of rings in contact) on a floor for 20 ms, each run against a
 new cache directory (``NUMBA_CACHE_DIR``; the checkout's own cache is not touched).
 
-    python benchmarks/cold_start.py   # writes benchmarks/results/cold_start.md (about 2 min)
+    python benchmarks/cold_start.py   # writes benchmarks/results/cold_start.md (about 8 min)
 
 The subprocesses compile each kernel once between them (``ballenv/physics/compile_lock.py``): the
 first to need it compiles it, the others wait and load it from the cache, so four envs take about
@@ -39,17 +41,24 @@ if __name__ == "__main__":
     envs.close()
 """
 
+FIRST_SIMULATE = """
+import sys
+from ballenv.physics import Ground, Ring, Scene, simulate
 
-def cold_start(n_envs):
-    """(wall s, CPU s of the process and its subprocesses) of ``n_envs`` envs' first steps on an
-    empty numba cache."""
+n = int(sys.argv[1])
+rings = [Ring(radius=0.1, n_nodes=32, pressure=30e3, position=(0.25 * k, 0.3)) for k in range(n)]
+simulate(Scene(rings=rings, grounds=[Ground()]), t_end=0.02)
+"""
+
+
+def cold_start(script, n):
+    """(wall s, CPU s of the process and its subprocesses) of ``script`` run with the argument ``n``
+    (envs or rings) on an empty numba cache."""
     with tempfile.TemporaryDirectory() as cache:
         env = dict(os.environ, NUMBA_CACHE_DIR=cache, OPENBLAS_NUM_THREADS="1")
         before = resource.getrusage(resource.RUSAGE_CHILDREN)
         start = time.perf_counter()
-        subprocess.run(
-            [sys.executable, "-c", FIRST_STEPS, str(n_envs)], env=env, check=True, capture_output=True
-        )
+        subprocess.run([sys.executable, "-c", script, str(n)], env=env, check=True, capture_output=True)
         wall = time.perf_counter() - start
         after = resource.getrusage(resource.RUSAGE_CHILDREN)
     cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
@@ -60,19 +69,27 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--envs", type=int, default=4, help="subprocess envs of the vector run (default 4)")
     args = parser.parse_args()
-    rows = [(n, *cold_start(n)) for n in (1, args.envs)]
+    envs = [(n, *cold_start(FIRST_STEPS, n)) for n in (1, args.envs)]
+    scenes = [(n, *cold_start(FIRST_SIMULATE, n)) for n in (1, 2)]
     lines = [
         "# Cold start: the first steps on an empty numba cache",
         "",
-        f"`python benchmarks/cold_start.py` on {os.cpu_count()} cores: make, reset and three steps of "
-        "`InflatedBall-v3`, a new `NUMBA_CACHE_DIR` per run.",
+        f"`python benchmarks/cold_start.py` on {os.cpu_count()} cores, a new `NUMBA_CACHE_DIR` per run. "
+        "The env: make, reset and three steps of `InflatedBall-v3`.",
         "",
         "| envs | wall (s) | CPU (s) |",
         "|---:|---:|---:|",
         *(
             f"| {n} ({'one process' if n == 1 else 'AsyncVectorEnv'}) | {w:.1f} | {c:.1f} |"
-            for n, w, c in rows
+            for n, w, c in envs
         ),
+        "",
+        "The simulator: the first `simulate()` of `Scene`'s defaults (the self-contact barrier, error "
+        "control), rings of 32 nodes on a floor, 20 ms.",
+        "",
+        "| rings | wall (s) | CPU (s) |",
+        "|---:|---:|---:|",
+        *(f"| {n} | {w:.1f} | {c:.1f} |" for n, w, c in scenes),
         "",
     ]
     text = "\n".join(lines)

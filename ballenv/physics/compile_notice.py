@@ -22,7 +22,7 @@ from numba.core import event
 
 LOGGER = logging.getLogger(__name__)
 NOTICE = (
-    "compiling the simulator with numba (%s); once per install, about half a minute; "
+    "compiling the simulator with numba (%s); once per install, up to a few minutes; "
     "later runs load it from the cache"
 )
 

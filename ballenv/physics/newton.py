@@ -349,20 +349,25 @@ def newton_ring(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active, bw):
     """
     if bw is None:
         return newton_iterate(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active)
-    if not model.self_barrier:
-        return newton_iterate(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active)
-    rest_len, dhat = model.rest_len[r], reach(model, r)
-    its = 0
-    if near_pairs(x0, rest_len, dhat, bw) == 0:
+    barrier = model.self_barrier
+    rest_len = model.rest_len[r]
+    dhat = reach(model, r) if barrier else 0.0
+    safe = barrier and near_pairs(x0, rest_len, dhat, bw) > 0
+    if barrier and not safe:
         bw.mode[0] = PLAIN
         copy_into(bw.active0, active)
-        its = newton_iterate(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active)
-        if its < 0 or self_intersects(x1) or near_pairs(x1, rest_len, dhat, bw) == 0:
-            return its
+    its = 0
+    while True:  # one call of the inlined iteration: the plain try, then at most one safe solve
+        if safe:
+            bw.mode[0] = SAFE
+        got = newton_iterate(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active)
+        if safe:
+            return FAILED if got < 0 else got + its
+        if not barrier or got < 0 or self_intersects(x1) or near_pairs(x1, rest_len, dhat, bw) == 0:
+            return got
         copy_into(active, bw.active0)
-    bw.mode[0] = SAFE
-    safe = newton_iterate(model, solver, r, x0, v0, a0, h, x1, v1, a1, ws, active)
-    return FAILED if safe < 0 else safe + its
+        its = got
+        safe = True
 
 
 @kernel(inline="always")

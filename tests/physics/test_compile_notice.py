@@ -31,7 +31,7 @@ def test_a_compile_of_ballenv_code_is_logged_at_info(caplog):
     assert records[0] == (
         NOTICE_LOGGER,
         logging.INFO,
-        "compiling the simulator with numba (add_one); once per install, about half a minute; "
+        "compiling the simulator with numba (add_one); once per install, up to a few minutes; "
         "later runs load it from the cache",
     )
     assert records[1][:2] == (NOTICE_LOGGER, logging.INFO)
