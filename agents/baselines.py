@@ -1,9 +1,8 @@
-"""Policies for InflatedBall-v3 behind one interface: ``reset(seed)`` at an episode start, then
-``act(obs) -> action`` (float32 array of shape (1,)).
+"""Every policy InflatedBall-v3 is scored with, made by name (:func:`make_policy`); each is an
+``agents.policies.Policy``: ``reset(seed)`` at an episode start, then ``act(obs) -> action``.
 
-* :class:`RandomPolicy`: uniform actions in [-1, 1] from its own seeded generator;
-* :class:`HeuristicPolicy`: the scripted controller of the env's action mode
-  (:class:`ballenv.controllers.PressurePump` or :class:`ballenv.controllers.PaddleDribble`);
+* ``"random"``, ``"heuristic"``: :class:`agents.policies.RandomPolicy`,
+  :class:`agents.policies.HeuristicPolicy` (the scripted controller of the env's action mode);
 * :class:`agents.lookahead.LookaheadPump` / :class:`agents.lookahead.LookaheadPaddle` ("lookahead"):
   the privileged references, the pump's amplitude or the paddle's strike of each bounce found by
   trying candidates on copies of the simulator;
@@ -16,85 +15,18 @@ from __future__ import annotations
 import os
 import pathlib
 from collections.abc import Callable
-from typing import Any, Protocol
+from typing import Any
 
 import gymnasium as gym
 import numpy as np
 from numpy.typing import NDArray
 
-from ballenv.controllers import PaddleDribble, PressurePump
-from ballenv.envs.inflated_ball import ball_env
-from ballenv.physics.ring import total_mass
+from .config import ALGORITHMS
+from .lookahead import lookahead_for
+from .policies import HeuristicPolicy, Policy, RandomPolicy
+from .wrappers import wrapper_class
 
-ALGORITHMS = ("ppo", "sac")
 NAMED_POLICIES = ("random", "heuristic", "lookahead")  # make_policy's policies by name
-HEURISTIC_PARAMS = pathlib.Path(__file__).parent / "hyperparams" / "heuristic.yml"
-
-
-class Policy(Protocol):
-    """What every policy here is: ``reset(seed)`` at an episode start, then ``act(obs)``."""
-
-    name: str
-
-    def reset(self, seed: int) -> None: ...
-
-    def act(self, obs: NDArray[np.float32]) -> NDArray[np.float32]: ...
-
-
-class RandomPolicy:
-    """Uniform random actions; the same seed gives the same actions."""
-
-    name = "random"
-
-    def __init__(self, env: gym.Env[Any, Any]) -> None:
-        self.rng = np.random.default_rng(0)
-
-    def reset(self, seed: int) -> None:
-        self.rng = np.random.default_rng(seed)
-
-    def act(self, obs: NDArray[np.float32]) -> NDArray[np.float32]:
-        return self.rng.uniform(-1.0, 1.0, size=1).astype(np.float32)
-
-
-class HeuristicPolicy:
-    """The scripted controller of the env's action mode (pressure pumping or paddle dribbling), with
-    the parameters ``params`` (default: the tuned ones of ``hyperparams/heuristic.yml`` for the env's
-    id, see ``agents.tune``; the controller's own defaults where the file has no entry)."""
-
-    name = "heuristic"
-
-    def __init__(self, env: gym.Env[Any, Any], params: dict[str, float] | None = None) -> None:
-        ball = ball_env(env)
-        config, structure = ball.config, ball.observation_structure
-        params = tuned_heuristic(config.action_mode) if params is None else dict(params)
-        self.controller: PressurePump | PaddleDribble
-        if config.action_mode == "pressure":
-            self.controller = PressurePump(structure, gravity=config.gravity, **params)
-        else:
-            mass = total_mass(config.ring(config.initial_pressure))
-            self.controller = PaddleDribble(
-                structure, mass, gravity=config.gravity, max_impulse=config.paddle_max_impulse, **params
-            )
-
-    def reset(self, seed: int) -> None:
-        self.controller.reset()
-
-    def act(self, obs: NDArray[np.float32]) -> NDArray[np.float32]:
-        return self.controller.act(obs)
-
-
-def heuristic_table() -> dict[str, dict[str, float]]:
-    """The tuned controllers' parameters of ``hyperparams/heuristic.yml``: env id -> dict."""
-    import yaml
-
-    return (yaml.safe_load(HEURISTIC_PARAMS.read_text()) if HEURISTIC_PARAMS.exists() else None) or {}
-
-
-def tuned_heuristic(mode: str) -> dict[str, float]:
-    """The scripted controller's tuned parameters for action mode ``mode`` (a dict; empty if none)."""
-    from ballenv.envs import ENV_IDS
-
-    return dict(heuristic_table().get(ENV_IDS[mode]) or {})
 
 
 class ModelPolicy:
@@ -168,8 +100,6 @@ def _run_wrapper(path: pathlib.Path, env: gym.Env[Any, Any]) -> gym.ObservationW
         return None
     import yaml
 
-    from .wrappers import wrapper_class
-
     cls = wrapper_class(yaml.safe_load(config.read_text()).get("env_wrapper"))
     return None if cls is None else cls(env)
 
@@ -206,8 +136,6 @@ def make_policy(
     if spec == "heuristic":
         return HeuristicPolicy(env)
     if spec == "lookahead":
-        from .lookahead import lookahead_for
-
         return lookahead_for(env)
     path = pathlib.Path(spec)
     if not path.exists():

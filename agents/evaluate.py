@@ -8,7 +8,7 @@
 Episode ``k`` is reset with seed ``seed + k`` (default 10,000 on: training uses small seeds), so
 the same arguments give the same numbers. Without ``--env-kwargs``, a run folder is scored on the
 env it trained on, ``random`` and ``heuristic`` on the task of their mode (the ``env_kwargs`` of
-``agents/hyperparams/ppo.yml``, :func:`agents.train.task_env_kwargs`).
+``agents/hyperparams/ppo.yml``, :func:`agents.config.task_env_kwargs`).
 
 Metrics (the reward is the env's training signal; these are the task's measures):
 
@@ -38,10 +38,10 @@ import numpy as np
 from ballenv.envs.config import BallEnvConfig
 from ballenv.envs.inflated_ball import ball_env
 
-from .baselines import NAMED_POLICIES, Policy, make_policy
+from .baselines import NAMED_POLICIES, make_policy
+from .config import ENV_ID, SUCCESS_TOLERANCE, parse_env_kwargs, task_env_kwargs
+from .policies import Policy
 
-ENV_ID = "ballenv:InflatedBall-v3"
-SUCCESS_TOLERANCE = 0.05  # relative apex error counted as a success
 DEFAULT_SEED = 10_000
 
 
@@ -153,17 +153,6 @@ def table(scores: Sequence[Score]) -> str:
     return "\n".join(lines)
 
 
-def parse_env_kwargs(text: str) -> dict[str, Any]:
-    """``--env-kwargs`` as a JSON object (e.g. '{"action_mode": "paddle"}')."""
-    try:
-        value = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise SystemExit(f"--env-kwargs = {text!r} is not a JSON object: {exc}") from exc
-    if not isinstance(value, dict):
-        raise SystemExit(f"--env-kwargs = {text!r} must be a JSON object of env keyword arguments")
-    return value
-
-
 def build_parser() -> argparse.ArgumentParser:
     """The command line of ``python -m agents.evaluate`` / ``ballenv-evaluate``."""
     parser = argparse.ArgumentParser(prog="ballenv-evaluate", description=__doc__.split("\n")[0])
@@ -184,8 +173,6 @@ def main(argv: Sequence[str] | None = None) -> None:
     if args.env_kwargs is None and args.policy not in NAMED_POLICIES:
         env_kwargs = _run_env_kwargs(args.policy)
     elif args.env_kwargs is None:  # a baseline: on the task the agents of its mode train on
-        from .train import task_env_kwargs
-
         env_kwargs = task_env_kwargs("ppo", args.action_mode or "pressure")
     if args.action_mode:
         env_kwargs["action_mode"] = args.action_mode

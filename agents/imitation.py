@@ -40,6 +40,10 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from .config import ENV_ID, task_env_kwargs
+from .lookahead import lookahead_for
+from .wrappers import wrapper_class
+
 if TYPE_CHECKING:
     import torch
     from stable_baselines3.common.base_class import BaseAlgorithm
@@ -99,10 +103,6 @@ def record(
     (one of ``WRAPPERS``)."""
     import gymnasium as gym
     from tqdm.auto import tqdm
-
-    from .evaluate import ENV_ID
-    from .lookahead import lookahead_for
-    from .wrappers import wrapper_class
 
     task = wrapper_class(wrapper) if wrapper in WRAPPERS else None
     if task is None:
@@ -249,8 +249,6 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
 
 def main(argv: Sequence[str] | None = None) -> None:
     """``python -m agents.imitation``: record the lookahead's demonstrations to ``--out``."""
-    from .train import task_env_kwargs
-
     args = parse_args(argv)
     env_kwargs = task_env_kwargs("ppo", TASKS[args.wrapper])
     demonstrations = record(env_kwargs, args.episodes, args.seed, args.wrapper)

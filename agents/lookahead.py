@@ -2,9 +2,10 @@
 chosen at each bounce by trying candidates on copies of the simulator's exact state.
 
 :class:`LookaheadPump` is not a controller an agent could become: it reads the simulator (it copies
-the env's batch, ``ballenv.envs.batch.BallBatch.copy_env``) and looks one bounce ahead. It bounds what
-the pump's timing (:meth:`ballenv.controllers.PressurePump.timed`: ``+u`` on the ground and below
-the landing height, ``-u`` above) can reach when each bounce's amplitude ``u`` is right; the gap from
+the env's state onto copies of its ball: ``InflatedBallEnv.planning_copies`` and ``copy_state_to``)
+and looks one bounce ahead. It bounds what the pump's timing
+(:meth:`ballenv.controllers.PressurePump.timed`: ``+u`` on the ground and below the landing height,
+``-u`` above) can reach when each bounce's amplitude ``u`` is right; the gap from
 it to the scripted pump and to a trained policy is what choosing ``u`` from the observation costs.
 
 At the episode's start and after each flight apex it runs ``candidates`` copies, amplitudes evenly
@@ -23,10 +24,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ballenv.controllers import PressurePump
-from ballenv.envs.batch import BallBatch
 from ballenv.envs.inflated_ball import ball_env
 
-from .baselines import tuned_heuristic
+from .config import tuned_heuristic
+from .policies import HeuristicPolicy
 from .wrappers import AMPLITUDE_SPAN
 
 
@@ -54,9 +55,8 @@ class Lookahead:
                 "span in (0, 1], candidates >= 2"
             )
         self.structure = ball.observation_structure
-        self.env_batch = ball._batch
-        low, high = config.observation_bounds()
-        self.copies = BallBatch(config.scene(), candidates, config.task_settings(), low, high)
+        self.ball = ball
+        self.copies = ball.planning_copies(candidates)
         self.offsets = np.linspace(-span, span, candidates)
         self.values = self.offsets.copy()  # the last plan's candidates
         self.horizon = horizon
@@ -65,7 +65,7 @@ class Lookahead:
         self.candidate_errors = np.full(candidates, np.nan)
 
     def reset(self, seed: int) -> None:
-        """A new episode (the ``agents.baselines.Policy`` protocol)."""
+        """A new episode (the ``agents.policies.Policy`` protocol)."""
         raise NotImplementedError
 
     def act(self, obs: NDArray[np.float32]) -> NDArray[np.float32]:
@@ -87,7 +87,7 @@ class Lookahead:
         ``expected_error``."""
         self.values = values = centre + self.offsets
         copies = self.copies
-        copies.copy_env(self.env_batch, 0, np.arange(values.size))
+        self.ball.copy_state_to(copies, np.arange(values.size))
         target = copies.task.target[0]
         signed = np.full(values.size, np.nan)
         landed = np.zeros(values.size, dtype=bool)
@@ -129,7 +129,7 @@ class LookaheadPump(Lookahead):
         self.amplitude = None
 
     def act(self, obs: NDArray[np.float32]) -> NDArray[np.float32]:
-        if self.amplitude is None or self.env_batch.task.apex_count[0] > 0:
+        if self.amplitude is None or self.ball.apexes_last_step > 0:
             self.amplitude = self.plan()
         return self.pump.timed(obs, self.amplitude)
 
@@ -154,8 +154,6 @@ class LookaheadPaddle(Lookahead):
     def __init__(
         self, env: gym.Env[Any, Any], span: float = 0.1, candidates: int = 41, horizon: int = 300
     ) -> None:
-        from .baselines import HeuristicPolicy
-
         super().__init__(env, span, candidates, horizon)
         self.scripted = HeuristicPolicy(env)
         self.in_reach = self.structure["paddle_in_reach"]

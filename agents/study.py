@@ -42,8 +42,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .evaluate import Score, evaluate, parse_env_kwargs
-from .train import add_cluster_argument, task_env_kwargs
+from .config import parse_env_kwargs, task_env_kwargs
+from .evaluate import Score, evaluate
+from .train import ROOT, add_cluster_argument, compile_once, parse_args, train
 
 RESAMPLES = 2000
 
@@ -165,8 +166,6 @@ def run_seed(job: SeedJob) -> SeedResult:
 
 def train_seed(job: SeedJob) -> pathlib.Path:
     """The run folder of ``job``'s seed, trained now unless it holds scores already."""
-    from .train import parse_args, train
-
     run = job.out / f"{job.algo}_{job.action_mode}_seed{job.seed}"
     if (run / "scores.json").exists():
         return run
@@ -199,8 +198,6 @@ def train_seeds(args: argparse.Namespace, env_kwargs: dict[str, Any]) -> list[Se
     (``args.cluster``), in seed order. A seed whose task was lost with its worker is reported and
     left out; a RuntimeError if every seed was lost."""
     from ballenv.cluster import collect, run_tasks
-
-    from .train import ROOT, compile_once
 
     jobs = [
         SeedJob(args.algo, args.action_mode, seed, args.timesteps, args.episodes, args.out, env_kwargs,

@@ -47,18 +47,18 @@ if TYPE_CHECKING:
     from stable_baselines3.common.callbacks import BaseCallback
     from stable_baselines3.common.vec_env import VecEnv
 
-    from .evaluate import Score
-    from .imitation import Demonstrations
 
-HYPERPARAMS = pathlib.Path(__file__).parent / "hyperparams"
+from .config import UsageError, env_id, load_hyperparams, parse_env_kwargs, task_env_kwargs
+from .evaluate import Score, evaluate, table
+from .imitation import TASKS, WRAPPERS, Demonstrations, pretrain
+from .wrappers import wrapper_class
+
 ROOT = pathlib.Path(__file__).resolve().parent.parent  # holds agents/: on a Ray worker's PYTHONPATH
 RUN_KEYS = ("n_timesteps", "n_envs", "policy", "normalize", "env_kwargs", "env_wrapper")
 OnEvaluation = Callable[[int, float], bool]  # (env steps, mean return) -> go on training
 
 
 def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
-    from .evaluate import parse_env_kwargs
-
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--algo", choices=("ppo", "sac"), default="ppo", help="algorithm (default ppo)")
     p.add_argument(
@@ -116,44 +116,6 @@ def check_cluster_name(text: str) -> str:
         raise argparse.ArgumentTypeError(str(err)) from None
 
 
-def env_id(mode: str) -> str:
-    """The registered id of action mode ``mode`` (``ballenv.envs.ENV_IDS``), module-qualified so that
-    spawned workers import ballenv."""
-    from ballenv.envs import ENV_IDS
-
-    return f"ballenv:{ENV_IDS[mode]}"
-
-
-def load_hyperparams(algo: str, mode: str, conf_file: str | None = None) -> dict[str, Any]:
-    """The YAML entry for the env id of action mode ``mode`` (a dict) in ``conf_file`` (a path, or
-    the name of a file in ``agents/hyperparams`` without ``.yml``; default: ``algo``'s file); a
-    :class:`UsageError` if there is no such file or entry."""
-    from ballenv.envs import ENV_IDS
-
-    path = HYPERPARAMS / f"{algo}.yml"
-    if conf_file is not None:
-        given = pathlib.Path(conf_file)
-        path = given if given.suffix in (".yml", ".yaml") else HYPERPARAMS / f"{conf_file}.yml"
-        if not path.exists():
-            names = sorted(f.stem for f in HYPERPARAMS.glob("*.yml"))
-            raise UsageError(f"--conf-file = {conf_file!r}: no such file (the project's: {names})")
-    table = yaml.safe_load(path.read_text()) or {}
-    if ENV_IDS[mode] not in table:
-        raise UsageError(f"{path} has no entry for {ENV_IDS[mode]} (--action-mode {mode}): {sorted(table)}")
-    return dict(table[ENV_IDS[mode]])
-
-
-def task_env_kwargs(
-    algo: str, mode: str, extra: dict[str, Any] | None = None, entry: Mapping[str, Any] | None = None
-) -> dict[str, Any]:
-    """The env keywords of the task ``algo`` trains on in action mode ``mode``: the ``env_kwargs``
-    of ``entry`` (default: the YAML entry), updated with ``extra`` (a command line's
-    ``--env-kwargs``), and the mode. What the training envs get, and what every policy compared with
-    the trained one is scored on."""
-    entry = load_hyperparams(algo, mode) if entry is None else entry
-    return {**(entry.get("env_kwargs") or {}), **(extra or {}), "action_mode": mode}
-
-
 def run_folder(log_dir: str | os.PathLike[str], algo: str, mode: str, seed: int) -> pathlib.Path:
     base = pathlib.Path(log_dir) / f"{algo}_{mode}_seed{seed}"
     path, k = base, 1
@@ -191,8 +153,6 @@ def make_envs(
 ) -> VecEnv:
     from stable_baselines3.common.env_util import make_vec_env
     from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecNormalize
-
-    from .wrappers import wrapper_class
 
     compile_once(env_kwargs)
     envs = make_vec_env(
@@ -292,10 +252,6 @@ def callbacks(
     return [evaluation, checkpoints, ProgressBar()]
 
 
-class UsageError(ValueError):
-    """A command-line or hyperparameter mistake: reported in one line, before any run folder exists."""
-
-
 def check_hyperparams(cls: type[BaseAlgorithm], algo_kwargs: Mapping[str, Any]) -> None:
     """Raise :class:`UsageError` naming every key of ``algo_kwargs`` that the algorithm ``cls``
     does not take (with the nearest valid names)."""
@@ -347,8 +303,6 @@ def load_demonstrations(args: argparse.Namespace, wrapper: str | None) -> Demons
     the file does not load or the run is not PPO behind their task's wrapper."""
     if args.demonstrations is None:
         return None
-    from .imitation import TASKS, WRAPPERS, Demonstrations
-
     if args.algo != "ppo" or wrapper not in WRAPPERS or TASKS[wrapper] != args.action_mode:
         raise UsageError(
             f"--demonstrations needs --algo ppo and an env_wrapper of its --action-mode among {TASKS}; "
@@ -383,8 +337,6 @@ def train(args: argparse.Namespace, on_evaluation: OnEvaluation | None = None) -
     import torch
     from stable_baselines3 import PPO, SAC
     from stable_baselines3.common.vec_env import VecNormalize
-
-    from .wrappers import wrapper_class
 
     hp = load_hyperparams(args.algo, args.action_mode, args.conf_file)
     hp.update(args.hyperparams or {})
@@ -435,8 +387,6 @@ def train(args: argparse.Namespace, on_evaluation: OnEvaluation | None = None) -
         )  # fmt: skip
         opened.pop_all()  # set up: the envs stay open for the training
     if demonstrations is not None:
-        from .imitation import pretrain
-
         fit = pretrain(model, envs, demonstrations)
         action, value = fit["action_mse"], fit["value_mse"]
         print(f"pretrained on {len(demonstrations.actions)} demonstrated bounces: held-back mean "
@@ -461,8 +411,6 @@ def score(
     run: pathlib.Path, args: argparse.Namespace, env_kwargs: dict[str, Any], wall: float, steps: int
 ) -> None:
     """Score the best model and the baselines on the same held-out seeds; write tables and a plot."""
-    from .evaluate import evaluate, table
-
     best = run / "best_model.zip"
     policy = best if best.exists() else run / "model.zip"
     specs = [str(policy)] + ([] if args.no_baselines else ["heuristic", "random"])

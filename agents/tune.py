@@ -10,7 +10,7 @@ seeds; the held-out seeds of ``agents.evaluate`` (10,000 on) stay unseen.
 * ``heuristic``: the controller's parameters (:data:`HEURISTIC_SPACE`); objective the mean apex
   error over ``--episodes`` episodes seeded 0, 1, ... of the task the agents train on (the
   ``env_kwargs`` of ``hyperparams/ppo.yml``). The best is written to
-  ``agents/hyperparams/heuristic.yml`` under the env id, where ``agents.baselines.HeuristicPolicy``
+  ``agents/hyperparams/heuristic.yml`` under the env id, where ``agents.policies.HeuristicPolicy``
   reads it (``--dry-run``: print it only).
 * ``ppo``: the hyperparameters of :func:`sample_ppo` (the ranges of RL Baselines3 Zoo's PPO
   sampler, narrowed to this budget); each trial trains ``--timesteps`` env steps with
@@ -44,9 +44,11 @@ import yaml
 if TYPE_CHECKING:
     import optuna
 
-from .baselines import HEURISTIC_PARAMS, HeuristicPolicy, heuristic_table
+from .config import HEURISTIC_PARAMS, heuristic_table, load_hyperparams, task_env_kwargs
 from .evaluate import evaluate
-from .train import ROOT, OnEvaluation, add_cluster_argument, compile_once, task_env_kwargs
+from .policies import HeuristicPolicy
+from .train import ROOT, OnEvaluation, add_cluster_argument, compile_once, train
+from .train import parse_args as train_args
 
 # name -> (low, high, log scale) of each controller parameter
 HEURISTIC_SPACE = {
@@ -138,7 +140,7 @@ def tune_heuristic(args: argparse.Namespace) -> optuna.Study:
         header = (
             "# The scripted controllers' parameters, tuned by `python -m agents.tune heuristic` (Optuna\n"
             "# TPE, mean apex error over training seeds), one entry per env id; read by\n"
-            "# agents.baselines.HeuristicPolicy.\n"
+            "# agents.policies.HeuristicPolicy.\n"
         )
         HEURISTIC_PARAMS.write_text(header + yaml.safe_dump(table, sort_keys=True))
         print(f"wrote {HEURISTIC_PARAMS}")
@@ -179,9 +181,7 @@ def train_ppo_trial(argv: Sequence[str], on_evaluation: OnEvaluation | None = No
     """Train one PPO trial with ``agents.train``'s command line ``argv``: its last periodic
     evaluation (mean return), its run folder and every evaluation; ``on_evaluation``: as
     ``agents.train.train``'s (it prunes the trial)."""
-    from .train import parse_args, train
-
-    run = train(parse_args(list(argv)), on_evaluation=on_evaluation)
+    run = train(train_args(list(argv)), on_evaluation=on_evaluation)
     log = np.load(run / "evaluations.npz")
     returns = [float(r) for r in log["results"].mean(axis=1)]
     reports = tuple(zip((int(t) for t in log["timesteps"]), returns, strict=True))
@@ -292,8 +292,6 @@ def tell(study: optuna.Study, trial: optuna.Trial, result: TrialResult | None) -
 
 def _current_ppo(mode: str) -> dict[str, Any]:
     """The PPO file's values for ``mode`` as trial parameters (the first trial)."""
-    from .train import load_hyperparams
-
     hp = load_hyperparams("ppo", mode)
     keys = ("n_steps", "batch_size", "gamma", "gae_lambda", "learning_rate", "n_epochs", "clip_range")
     params = {k: hp[k] for k in keys}

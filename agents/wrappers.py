@@ -18,9 +18,13 @@ import gymnasium as gym
 import numpy as np
 from numpy.typing import NDArray
 
+from ballenv.controllers import PressurePump
 from ballenv.envs.inflated_ball import ball_env
 from ballenv.envs.observation import MAX_NODE_FORCE, MAX_SPEED
-from ballenv.physics.ring import total_mass
+from ballenv.envs.task import height_reward
+
+from .config import SUCCESS_TOLERANCE, tuned_heuristic
+from .policies import HeuristicPolicy
 
 KEPT_FIELDS = (
     "centre_of_mass_position", "centre_of_mass_velocity", "pressure", "pressure_setpoint",
@@ -196,9 +200,6 @@ class PumpAmplitude(BallLandingObservation):
     a time (``agents.evaluate``): it asks the model for an amplitude when a bounce starts."""
 
     def __init__(self, env: gym.Env[NDArray[np.float32], NDArray[np.float32]]) -> None:
-        from ballenv.controllers import PressurePump
-
-        from .baselines import tuned_heuristic
 
         super().__init__(env)
         require_mode(env, "pressure", "PumpAmplitude", "sets the pump's amplitude")
@@ -366,9 +367,6 @@ def apex_tolerance(info: dict[str, Any], last: float, terminated: bool, env_marg
     Without an apex: 0 if the episode ``terminated`` (the ball at rest or out of the arena), else
     the same tolerance of the apex the env's last reward ``last`` rates (its margin ``env_margin``:
     ``last^((env_margin / 0.05)^2)``)."""
-    from ballenv.envs.batch import height_reward
-
-    from .evaluate import SUCCESS_TOLERANCE
 
     if info.get("apex_count"):
         target = info["target_height"]
@@ -400,13 +398,13 @@ class PaddleStrike(BallRotationObservation):
     time (``agents.evaluate``): it asks the model for a correction at the same moments."""
 
     def __init__(self, env: gym.Env[NDArray[np.float32], NDArray[np.float32]]) -> None:
-        from .baselines import HeuristicPolicy
 
         super().__init__(env)
         require_mode(env, "paddle", "PaddleStrike", "corrects the paddle's strike")
-        config = ball_env(env).config
+        ball = ball_env(env)
+        config = ball.config
         self.scripted = HeuristicPolicy(env)
-        self.mass = total_mass(config.ring(config.initial_pressure))
+        self.mass = ball.ball_mass
         self.max_impulse = config.paddle_max_impulse
         self.env_margin = config.reward_margin
         self.in_reach = self.structure["paddle_in_reach"]
@@ -508,7 +506,6 @@ class ResidualPump(BallStateObservation):
     env's observations)."""
 
     def __init__(self, env: gym.Env[NDArray[np.float32], NDArray[np.float32]]) -> None:
-        from .baselines import HeuristicPolicy
 
         super().__init__(env)
         require_mode(env, "pressure", "ResidualPump", "corrects the pump")

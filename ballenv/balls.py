@@ -14,7 +14,7 @@ How a preset is made (SI units):
 
 * **radius and mass** are the rule's (mid-range): the ring's inflated radius ``r`` at the rule's
   pressure ``p`` is the ball's radius, so its rest radius is ``R = r / (1 + r p cos(pi/N) / (E h))``
-  (from ``r = R / (1 - q)``, :mod:`ballenv.physics.ring`); its density is the one that gives the
+  (from ``r = R / (1 - q)``, :mod:`ballenv.physics.base.ring`); its density is the one that gives the
   ball's mass ``M = N rho b h l0``.
 * **width** ``b = 2 r``: the ring is the ball's central slice, as wide as the ball. The gas then
   pushes on the ground over about the same area as the ball's flattened patch, and the contact
@@ -42,9 +42,10 @@ from typing import Any
 
 import numpy as np
 
-from .physics import Ground, Ring, Scene, simulate
+from ballenv.physics import Ground, Ring, Scene, simulate
+from ballenv.physics.base.ring import inflated_radius, rest_edge_length, total_mass
+
 from .physics.presets import with_fidelity
-from .physics.ring import inflated_radius, rest_edge_length, total_mass
 
 P_ATM = 101325.0  # Pa
 G = 9.81  # m/s^2

@@ -120,7 +120,7 @@ def warm_simulator(run: Callable[..., Any] | None = None) -> None:
     kernels a sweep of scenes calls, their energies included."""
     from dataclasses import replace
 
-    from .physics import Ground, Ring, Scene, simulate
+    from ballenv.physics import Ground, Ring, Scene, simulate
 
     run = simulate if run is None else run
     ring = Ring(radius=0.1, n_nodes=8, youngs_modulus=1e7, thickness=0.005, width=0.02, pressure=1e4)

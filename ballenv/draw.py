@@ -2,7 +2,7 @@
 ground reactions, the paddle, the target line and text, rasterised with Pillow into an (H, W, 3)
 uint8 RGB array.
 
-The env's frames (:mod:`ballenv.render`), the scenes' videos (:mod:`ballenv.scenes.animate`) and
+The env's frames (:mod:`ballenv.envs.render`), the scenes' videos (:mod:`ballenv.scenes.animate`) and
 the docs' pictures are drawn on a :class:`Canvas`; the replay viewer's page (:mod:`ballenv.viewer`)
 draws in the browser with the colours and line widths of :data:`STYLE` (``STYLE.as_json()``).
 Positions in the plane are in m (y up), on the canvas in pixels (y down).

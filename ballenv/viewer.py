@@ -26,7 +26,7 @@ import sys
 import numpy as np
 
 from .draw import STYLE
-from .physics.simulation import Trajectory
+from .physics.trajectory import Trajectory
 
 
 def _b64(array):

@@ -14,7 +14,7 @@ cached in ``benchmarks/results/accuracy_references.json`` (``--references`` reco
 sweep: generalized-alpha, ``rho_infinity`` = 0.9, adaptive, largest step 10 ms, N = 64. Each
 tolerance with both controls of the step in contact (``Scene.contact_error``): "impulse" (the
 contact impulse at most ``rtol M sqrt(g R)``) and "doubling" (the contact errors of
-``ballenv/physics/contact_error.py``); the table says per ball and control whether the error fell at
+``ballenv/physics/step/contact_error.py``); the table says per ball and control whether the error fell at
 every tightening of ``rtol``, and the range of achieved over requested.
 """
 
@@ -33,9 +33,9 @@ import time  # noqa: E402
 from ball_family import BALLS, ball_scene, first_apex, gas_to_bending, reference_apex  # noqa: E402
 
 from ballenv.physics import Ground, SimulationError, simulate  # noqa: E402
+from ballenv.physics.build import initial_state  # noqa: E402
 from ballenv.physics.presets import FIDELITY_PRESETS, with_fidelity  # noqa: E402
 from ballenv.physics.scene import DEFAULT_RTOL  # noqa: E402
-from ballenv.physics.simulation import initial_state  # noqa: E402
 
 RESULTS = pathlib.Path(__file__).parent / "results"
 REFERENCES = RESULTS / "accuracy_references.json"
@@ -124,7 +124,7 @@ def sweep_table(refs, runs, tolerances):
         "to the ball's converged reference; `err/rtol`: achieved over requested; monotone: the error fell "
         "at every tightening of rtol. Control: `Scene.contact_error`, impulse (the contact impulse at most "
         "rtol M sqrt(g R), the default) or doubling (the contact errors of "
-        "`ballenv/physics/contact_error.py`).",
+        "`ballenv/physics/step/contact_error.py`).",
         "",
         "| ball | control | p R^3/EI | reference apex (m) | ref. uncertainty | "
         + " | ".join(f"rtol {t:g}: err (err/rtol), wall ms, steps" for t in tolerances)

@@ -30,7 +30,7 @@ sys.path.insert(0, str(ROOT))
 from scipy.optimize import brentq  # noqa: E402
 
 from ballenv.balls import BALLS, Ball, drop  # noqa: E402
-from ballenv.physics.ring import bending_stiffness  # noqa: E402
+from ballenv.physics.base.ring import bending_stiffness  # noqa: E402
 
 RESULTS = ROOT / "benchmarks" / "results"
 PRESSURE_FACTORS = (0.0, 0.2, 0.6, 0.8, 1.0, 1.2, 1.4)

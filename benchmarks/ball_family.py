@@ -34,7 +34,7 @@ import dataclasses
 import math
 
 from ballenv.physics import Ground, Ring, Scene, simulate
-from ballenv.physics.ring import total_mass
+from ballenv.physics.base.ring import total_mass
 
 T_END = {"env": 0.8}  # s, default 1 s: past the first apex
 REFERENCE_TOL = 5e-5  # the reference's contact impulse per step over M sqrt(g R)

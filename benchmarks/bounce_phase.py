@@ -26,7 +26,7 @@ import numpy as np  # noqa: E402
 from ballenv.envs.config import BallEnvConfig  # noqa: E402
 from ballenv.envs.numerics import ENV_FIDELITIES  # noqa: E402
 from ballenv.physics import simulate  # noqa: E402
-from ballenv.physics.ring import initial_nodes  # noqa: E402
+from ballenv.physics.base.ring import initial_nodes  # noqa: E402
 
 RESULTS = pathlib.Path(__file__).parent / "results"
 PHASES = 9  # rotations 0, 1/16, ..., 1/2 of the angle between two nodes

@@ -7,7 +7,7 @@ new cache directory (``NUMBA_CACHE_DIR``; the checkout's own cache is not touche
 
     python benchmarks/cold_start.py   # writes benchmarks/results/cold_start.md (about 8 min)
 
-The subprocesses compile each kernel once between them (``ballenv/physics/compile_lock.py``): the
+The subprocesses compile each kernel once between them (``ballenv/physics/base/compile_lock.py``): the
 first to need it compiles it, the others wait and load it from the cache, so four envs take about
 the CPU time of one.
 """

@@ -6,7 +6,7 @@ phase, against the paper's all-pairs node test, for 2-64 rings of 32 and 128 nod
 Scene: rings of radius 0.1 m (wall 2 mm) on a square lattice, each touching its neighbours (centres
 2 r + 3 mm apart: every neighbour pair has nodes within the 4 mm contact distance), as balls
 settled in a box. Both methods return the same contacts (checked here, and in
-tests/physics/test_collision.py). Time: median of repeats of one detection call, numba warm.
+tests/physics/walls/test_impulses.py). Time: median of repeats of one detection call, numba warm.
 """
 
 import os
@@ -20,8 +20,8 @@ import time  # noqa: E402
 import numpy as np  # noqa: E402
 from tqdm.auto import tqdm  # noqa: E402
 
-from ballenv.physics.collision import CONTACT_COLUMNS, find_contacts, find_contacts_all_pairs  # noqa: E402
-from ballenv.physics.model import build_collision_workspace  # noqa: E402
+from ballenv.physics.build import build_collision_workspace  # noqa: E402
+from ballenv.physics.walls.impulses import CONTACT_COLUMNS, find_contacts, find_contacts_all_pairs  # noqa: E402
 
 RESULTS = pathlib.Path(__file__).parent / "results"
 RINGS = (2, 8, 32, 64)

@@ -35,9 +35,7 @@ from step_cost import compile_times  # noqa: E402
 import ballenv  # noqa: E402, F401
 from ballenv.envs import ENV_ID  # noqa: E402
 from ballenv.envs.numerics import ENV_FIDELITIES  # noqa: E402
-from ballenv.physics.assembly import ring_force, ring_jacobian  # noqa: E402
-from ballenv.physics.integrator import coefficients  # noqa: E402
-from ballenv.physics.layout import (  # noqa: E402
+from ballenv.physics.base.layout import (
     COUNT_BY_REASON,
     COUNT_IMPULSE_REJECTED,
     COUNT_NEWTON,
@@ -46,8 +44,10 @@ from ballenv.physics.layout import (  # noqa: E402
     COUNTERS,
     REJECTIONS,
 )
-from ballenv.physics.linalg import solve_band_low_rank  # noqa: E402
-from ballenv.physics.model import build_workspace  # noqa: E402
+from ballenv.physics.base.linalg import solve_band_low_rank  # noqa: E402
+from ballenv.physics.build import build_workspace  # noqa: E402
+from ballenv.physics.effects.assembly import ring_force, ring_jacobian  # noqa: E402
+from ballenv.physics.step.integrator import coefficients  # noqa: E402
 
 RESULTS = pathlib.Path(__file__).parent / "results"
 _COLD_START_SNIPPET = f"""

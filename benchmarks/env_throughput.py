@@ -30,7 +30,7 @@ import ballenv  # noqa: E402, F401
 from ballenv.controllers import PaddleDribble, PressurePump  # noqa: E402
 from ballenv.envs.numerics import ENV_FIDELITIES, with_env_fidelity  # noqa: E402
 from ballenv.physics import Ground, Ring, Scene, simulate  # noqa: E402
-from ballenv.physics.ring import total_mass  # noqa: E402
+from ballenv.physics.base.ring import total_mass  # noqa: E402
 
 RESULTS = pathlib.Path(__file__).parent / "results"
 PRESETS = tuple(ENV_FIDELITIES)

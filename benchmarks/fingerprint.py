@@ -35,7 +35,7 @@ import work_precision as wp  # noqa: E402
 
 from ballenv.envs.inflated_ball import InflatedBallEnv  # noqa: E402
 from ballenv.physics import SimulationError, simulate  # noqa: E402
-from ballenv.physics.simulation import initial_state  # noqa: E402
+from ballenv.physics.build import initial_state  # noqa: E402
 
 INFO_LAYOUT = ("observation_structure",)  # the layout, not a result of the step
 

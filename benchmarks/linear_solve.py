@@ -19,9 +19,9 @@ import numpy as np  # noqa: E402
 from numba import njit  # noqa: E402
 
 from ballenv.physics import Ring, Scene  # noqa: E402
-from ballenv.physics.assembly import ring_jacobian  # noqa: E402
-from ballenv.physics.linalg import band_to_dense, solve_band_low_rank  # noqa: E402
-from ballenv.physics.model import build_model, build_workspace  # noqa: E402
+from ballenv.physics.base.linalg import band_to_dense, solve_band_low_rank  # noqa: E402
+from ballenv.physics.build import build_model, build_workspace  # noqa: E402
+from ballenv.physics.effects.assembly import ring_jacobian  # noqa: E402
 
 RESULTS = pathlib.Path(__file__).parent / "results"
 

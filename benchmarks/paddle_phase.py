@@ -42,7 +42,7 @@ import ballenv  # noqa: E402, F401  (registers the env)
 from agents.baselines import HeuristicPolicy  # noqa: E402
 from agents.wrappers import phase_harmonics, ring_angle, ring_spin, rotation_phase  # noqa: E402
 from ballenv.envs import ENV_IDS  # noqa: E402
-from ballenv.physics.ring import total_mass  # noqa: E402
+from ballenv.physics.base.ring import total_mass  # noqa: E402
 
 RESULT = ROOT / "benchmarks" / "results" / "paddle_phase.md"
 BODY = ("height", "vertical velocity", "apex seen", "target", "impulse")

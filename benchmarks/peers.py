@@ -69,8 +69,8 @@ import numpy as np  # noqa: E402
 
 import ballenv  # noqa: E402
 from ballenv.physics import Ground, Ring, Scene, simulate  # noqa: E402
+from ballenv.physics.base.ring import bending_stiffness, inflated_radius, rest_area  # noqa: E402
 from ballenv.physics.presets import FIDELITY_PRESETS, with_fidelity  # noqa: E402
-from ballenv.physics.ring import bending_stiffness, inflated_radius, rest_area  # noqa: E402
 from ballenv.physics.simulation import SimulationError  # noqa: E402
 
 RESULTS = pathlib.Path(__file__).parent / "results"

@@ -5,7 +5,7 @@
 Scenes (each run with ``Scene.self_intersection = "barrier"``, the joint implicit step of rings in
 contact, and ``"reject"``, the explicit impulses with their push-out): a head-on collision of two
 N = 32 balls at 3 m/s each (0.03 s), five balls stacked in a box 6 mm wider than a ball (3 s) and
-eight balls thrown into a box (3 s, ``impulse_tol`` = 5e-4 N s; ``tests/physics/test_collision.py``).
+eight balls thrown into a box (3 s, ``impulse_tol`` = 5e-4 N s; ``tests/physics/walls/test_impulses.py``).
 Reported: wall time (numba warm, best of two), accepted and rejected steps, Newton corrections,
 the largest kinetic energy over the last 0.5 s (jiggle), the largest rise of the total energy (with
 the contact energy between rings) above its start, and the energy the impulses' push-out created.
@@ -34,12 +34,12 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 from collision_cost import NODES, RINGS, lattice  # noqa: E402
 
 from ballenv.physics import Ring, Scene, simulate  # noqa: E402
-from ballenv.physics.collision import find_contacts  # noqa: E402
-from ballenv.physics.model import build_collision_workspace, build_model, build_ring_contact_workspace  # noqa: E402
-from ballenv.physics.ring_contact import find_ring_pairs  # noqa: E402
-from tests.physics import test_collision as collision_tests  # noqa: E402
-from tests.physics.test_collision import mirrored_pair  # noqa: E402
-from tests.physics.test_ring_contact import five_balls  # noqa: E402
+from ballenv.physics.build import build_collision_workspace, build_model, build_ring_contact_workspace  # noqa: E402
+from ballenv.physics.walls.impulses import find_contacts  # noqa: E402
+from ballenv.physics.walls.ring_barrier import find_ring_pairs  # noqa: E402
+from tests.physics.walls import test_impulses as collision_tests  # noqa: E402
+from tests.physics.walls.test_impulses import mirrored_pair  # noqa: E402
+from tests.physics.walls.test_ring_barrier import five_balls  # noqa: E402
 
 RESULTS = ROOT / "benchmarks" / "results"
 MODES = ("barrier", "reject")

@@ -51,7 +51,7 @@ sys.path.insert(0, str(ROOT))
 from ballenv.cluster import check_cluster, collect, run_tasks, warm_simulator  # noqa: E402
 from ballenv.envs.inflated_ball import InflatedBallEnv  # noqa: E402
 from ballenv.physics import Ground, Ring, Scene  # noqa: E402
-from ballenv.physics.ring import inflated_radius  # noqa: E402
+from ballenv.physics.base.ring import inflated_radius  # noqa: E402
 from tests.stability.invariants import (  # noqa: E402
     ENERGY_ROUND_OFF,
     GROUND_TOLERANCE,

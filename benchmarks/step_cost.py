@@ -20,7 +20,7 @@ import tempfile  # noqa: E402
 import numpy as np  # noqa: E402
 
 from ballenv.physics import Ring, Scene, simulate  # noqa: E402
-from ballenv.physics.ring import inflated_radius  # noqa: E402
+from ballenv.physics.base.ring import inflated_radius  # noqa: E402
 
 NODE_COUNTS = (16, 32, 64, 128, 256, 512)
 INTEGRATORS = ("backward_euler", "generalized_alpha")

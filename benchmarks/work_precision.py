@@ -37,8 +37,9 @@ import numpy as np  # noqa: E402
 
 from ballenv.cluster import check_cluster, collect, run_tasks, warm_simulator  # noqa: E402
 from ballenv.physics import Ground, Ring, Scene, simulate  # noqa: E402
+from ballenv.physics.build import initial_state  # noqa: E402
 from ballenv.physics.presets import FIDELITY_PRESETS, with_fidelity  # noqa: E402
-from ballenv.physics.simulation import SimulationError, initial_state  # noqa: E402
+from ballenv.physics.simulation import SimulationError  # noqa: E402
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent  # the checkout: Ray workers import from it
 RESULTS = ROOT / "benchmarks" / "results"
@@ -371,7 +372,7 @@ def vibration_decay(dt_max, impulse_tol=1e-3, window=(0.55, 1.05), t_end=1.5):
 
 
 def _ring_mass(scene):
-    from ballenv.physics.ring import node_mass
+    from ballenv.physics.base.ring import node_mass
 
     ring = scene.rings[0]
     return node_mass(ring) * ring.n_nodes

@@ -6,7 +6,7 @@ import math
 import pytest
 
 from ballenv.balls import BALLS, PSI, drop, regulation_ring
-from ballenv.physics.ring import inflated_radius, total_mass
+from ballenv.physics.base.ring import inflated_radius, total_mass
 
 KGF_PER_CM2 = 98066.5  # Pa
 

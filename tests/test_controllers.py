@@ -7,7 +7,7 @@ import pytest
 
 import ballenv  # noqa: F401  (registers the env)
 from ballenv.controllers import PaddleDribble, PressurePump
-from ballenv.physics.ring import total_mass
+from ballenv.physics.base.ring import total_mass
 
 
 def _episode(env, seed, controller, idle):

@@ -2,12 +2,12 @@
 
 Every env holds one ring above one flat ground; the rings share material and numerical settings
 and differ in state, gas and target. One :class:`Model` with per-ring arrays of length E holds all
-envs; env ``e`` is advanced by the same ``stepper.advance`` as ``simulate()``, on views of its
+envs; env ``e`` is advanced by the same ``step.stepper.advance`` as ``simulate()``, on views of its
 slices, with its own clock and step size. A batch of E envs therefore gives the same numbers as E
 batches of one (the single env is a batch of one).
 
 A control step of env ``e``: start the action (a gas ramp to the new setpoint, or a paddle strike
-spread over its duration: ``physics/drive.py``), advance to ``(k + 1) * control_dt`` (the steps
+spread over its duration: ``physics/step/actuation.py``), advance to ``(k + 1) * control_dt`` (the steps
 deliver it), and tally the apex events of the interval. Only an apex in flight counts
 (after a lift-off, before the next touchdown): the centre of mass also turns round inside a squash.
 """
@@ -15,57 +15,40 @@ deliver it), and tally the apex events of the interval. Only an apex in flight c
 import math
 from collections.abc import Callable, Mapping
 from concurrent.futures import ThreadPoolExecutor
-from typing import TYPE_CHECKING, Any, NamedTuple
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..physics.actuation import (
-    hold_gas,
-    ramp_rest_pressure,
-    rest_circle_radius,
-    restart,
-    set_gas,
-    spread_impulse,
-    stop_push,
-)
-from ..physics.contact import FREE
-from ..physics.effects.gas import ring_pressure
-from ..physics.geometry import centre_of_mass
-from ..physics.integrator import build_solver
-from ..physics.jit import kernel, python_entry
-from ..physics.layout import (
+from ballenv.physics.base.geometry import centre_of_mass
+from ballenv.physics.base.jit import kernel, python_entry
+from ballenv.physics.base.layout import (
     CLOCK_H,
     CLOCK_T,
     COUNT_EVENTS,
     COUNT_RECORDS,
     ENERGY_BUDGET,
-    ENERGY_FREE,
     ENERGY_TOTAL,
     EVENT,
-    EVENT_APEX,
-    EVENT_HEIGHT,
-    EVENT_KIND,
-    EVENT_LIFTOFF,
-    EVENT_TOUCHDOWN,
+    GROUND_NORMAL,
     N_CLOCK,
     N_COUNTERS,
     STATUS_BUFFER_FULL,
     STATUS_DONE,
-    Layout,
 )
-from ..physics.model import (
-    PER_RING_FIELDS,
-    Model,
-    Recording,
-    Workspace,
-    build_drive,
-    build_model,
-    build_workspace,
-    empty_state,
-    rings_view,
+from ballenv.physics.build import build, build_drive, build_workspace
+from ballenv.physics.effects.gas import ring_pressure
+from ballenv.physics.ground.contact import FREE
+from ballenv.physics.model import PER_RING_FIELDS, Recording, Workspace, rings_view
+from ballenv.physics.step.actuation import (
+    hold_gas,
+    rest_circle_radius,
+    restart,
+    set_gas,
+    stop_push,
 )
-from ..physics.stepper import advance
+from ballenv.physics.step.stepper import advance
+
 from .observation import (
     OBS_CENTRE_OF_MASS_POSITION,
     OBS_CENTRE_OF_MASS_VELOCITY,
@@ -83,74 +66,26 @@ from .observation import (
 )
 from .observation import size as layout_size
 from .observation import structure as layout_structure
+from .task import (
+    END_NONE,
+    MODE_PADDLE,
+    REWARD,
+    Task,
+    actuate,
+    env_ring,
+    outcome,
+    paddle_ready,
+    rise,
+    tally,
+)
 from .tickets import draw_ticket
 
 if TYPE_CHECKING:
     from ..physics.scene import Scene
 
-MODE_PRESSURE = 0
-MODE_PADDLE = 1
-END_NONE = 0
-END_REST = 1
-END_ARENA = 2
-END_FAILURE = 3
-END_REASONS = ("", "rest", "arena", "sim_failure")
-REWARD_TERMS = ("reward_height",)  # the terms' info keys
-# columns of Task.reward: the reward, then its terms in the order of REWARD_TERMS
-REWARD = Layout("total", *REWARD_TERMS)
-REWARD_TOTAL = REWARD.index("total")
-REWARD_HEIGHT = REWARD.index("reward_height")
-# the tolerance reward is 0.1 at a relative error of reward_margin (DeepMind Control's gaussian)
-REWARD_AT_MARGIN = 0.1
-REWARD_SCALE = math.sqrt(-2.0 * math.log(REWARD_AT_MARGIN))
 NO_OUTPUT = 1e300  # output interval of advance(): record only at the end of the control step
 EVENT_ROWS = 32
 ENVS_PER_LINE = 8  # envs of a float64 or int64 per-env array in one 64-byte cache line
-
-
-@kernel(inline="always")
-def env_ring():
-    """Index of an env's one ring in its model and state views (:func:`env_model`,
-    :func:`env_state`): 0, typed int64. Passed as the literal 0, the callees (restart, the energy,
-    the forces, ...) would each compile a second time, specialised on that literal."""
-    return np.int64(0)
-
-
-class Task(NamedTuple):
-    """The task's settings (scalars) and per-env values (arrays of length E)."""
-
-    mode: int
-    control_dt: float  # s
-    pressure_low: float  # Pa, gauge pressure at rest for action -1
-    pressure_high: float  # Pa, for action +1
-    pressure_rate: float  # Pa/s: the gas setpoint moves toward the command at most this fast
-    paddle_max_impulse: float  # N s, for action +1 (-1: no strike)
-    paddle_reach: float  # m: the paddle strikes when the ball's top is within this of its height
-    paddle_depth: float  # m: it touches the nodes within this of the ball's top
-    paddle_strike_duration: float  # s: a strike delivers its impulse at a constant rate over this
-    ground_height: float  # m
-    gravity: float  # m/s^2
-    reward_margin: float  # relative apex error at which the reward has fallen to REWARD_AT_MARGIN
-    arena_half_width: float  # m
-    arena_height: float  # m
-    rest_height: float  # m
-    target: np.ndarray  # (E,) m, target apex height of the centre of mass
-    setpoint: np.ndarray  # (E,) Pa, gas amount as gauge pressure at rest
-    rest_radius: np.ndarray  # (E,) m, radius of the inflated circle at the setpoint
-    paddle_height: np.ndarray  # (E,) m
-    airborne: np.ndarray  # (E,) bool: no ground contact since the last lift-off
-    last_apex: np.ndarray  # (E,) m: height of the last flight apex (the start height after a reset)
-    steps: np.ndarray  # (E,) int64 control steps taken
-    apex_count: np.ndarray  # (E,) int64 flight apexes in the last control step
-    apex_error: np.ndarray  # (E,) sum of |h - target| / target over them
-    apex_height: np.ndarray  # (E,) m, the last of them (0 if none)
-    impulse: np.ndarray  # (E,) N s delivered by the paddle in the last control step
-    in_reach: np.ndarray  # (E,) bool: the paddle can strike at the next step (see _paddle_ready)
-    struck: np.ndarray  # (E,) bool: the paddle struck since the ball last touched the ground
-    status: np.ndarray  # (E,) int64 stepper status of the last control step
-    rise: np.ndarray  # (E,) m: height the ball could still rise (free energy over m g)
-    reward: np.ndarray  # (E, REWARD.size): the reward and its terms (columns REWARD)
-    end: np.ndarray  # (E,) int64: END_NONE, END_REST, END_ARENA or END_FAILURE
 
 
 @kernel
@@ -229,99 +164,13 @@ def reset_env(
     task.apex_height[e] = 0.0
     task.impulse[e] = 0.0
     task.struck[e] = False
-    task.in_reach[e] = _paddle_ready(task, e, x, v)
+    task.in_reach[e] = paddle_ready(task, e, x, v)
     task.status[e] = STATUS_DONE
-    task.rise[e] = _rise(me, se, task, e)
+    task.rise[e] = rise(me, se, task, e)
     task.reward[e, :] = 0.0
     task.end[e] = END_NONE
     observe_env(model, state, task, e, obs[e])
     _clip(obs[e], low, high, out[e])
-
-
-@kernel(inline="always")
-def _rise(me, se, task, e):
-    """Height (m) the ball's centre could still rise: free energy (kinetic, elastic and gas above the
-    inflated circle at rest) over ``m g``, plus the centre's height above its resting height."""
-    x = se.x[0]
-    cy = centre_of_mass(x, se.v[0])[1]
-    weight = x.shape[0] * me.node_mass[0] * task.gravity
-    return se.energy[0, ENERGY_FREE] / weight + cy - task.ground_height - task.rest_radius[e]
-
-
-@kernel
-def _top(x):
-    """Height (m) of the highest node."""
-    top = -math.inf
-    for i in range(x.shape[0]):
-        top = max(top, x[i, 1])
-    return top
-
-
-@kernel(inline="always")
-def _paddle_ready(task, e, x, v):
-    """Whether the paddle can strike env ``e``'s ball (positions ``x``, velocities ``v``): paddle
-    mode, the ball in flight (no ground contact since its last lift-off) and falling (its centre of
-    mass moving down) with its top within ``paddle_reach`` of the paddle, and no strike yet in this
-    flight (one strike per flight, as a hand dribbles: it meets the ball coming down). Not on the
-    ground: a squashing ball's centre still moves down, and a strike there (energy ``v J`` at the
-    landing speed ``v``) doubled the bounce's energy for low targets, whose paddle reaches the
-    ground."""
-    if task.mode != MODE_PADDLE or task.struck[e] or not task.airborne[e]:
-        return False
-    falling = 0.0
-    for i in range(v.shape[0]):
-        falling += v[i, 1]
-    return falling < 0.0 and abs(_top(x) - task.paddle_height[e]) <= task.paddle_reach
-
-
-@kernel(inline="always")
-def _actuate(me, se, de, task, e, action, t, ws, nodes):
-    """Start env ``e``'s actuation of the control step from ``t`` (s), spread over time
-    (``physics/drive.py``; the stepper delivers it step by step): in pressure mode the gas ramp from
-    the amount held to the setpoint moved toward the command, reached at the control step's end; in
-    paddle mode a strike spread over ``paddle_strike_duration`` on the nodes within
-    ``paddle_depth`` of the top now."""
-    x = se.x[0]
-    n = x.shape[0]
-    task.impulse[e] = 0.0
-    if task.mode == MODE_PRESSURE:
-        command = task.pressure_low + 0.5 * (action + 1.0) * (task.pressure_high - task.pressure_low)
-        most = task.pressure_rate * task.control_dt
-        pressure = task.setpoint[e] + min(most, max(-most, command - task.setpoint[e]))
-        if pressure != task.setpoint[e]:
-            ramp_rest_pressure(me, de, env_ring(), pressure, t, (task.steps[e] + 1) * task.control_dt, ws)
-            task.setpoint[e] = pressure
-            task.rest_radius[e] = rest_circle_radius(me, env_ring(), pressure, n)
-        return
-    impulse = 0.5 * (action + 1.0) * task.paddle_max_impulse
-    if not task.in_reach[e] or impulse <= 0.0:
-        return
-    top = _top(x)
-    count = 0
-    for i in range(n):
-        if x[i, 1] >= top - task.paddle_depth:
-            nodes[count] = i
-            count += 1
-    spread_impulse(de, env_ring(), nodes, count, 0.0, -impulse, t, t + task.paddle_strike_duration)
-    task.impulse[e] = impulse
-    task.struck[e] = True
-
-
-@kernel(inline="always")
-def _tally(task, e, events, n_events):
-    for k in range(n_events):
-        kind = int(events[k, EVENT_KIND])
-        if kind == EVENT_TOUCHDOWN:
-            task.airborne[e] = False
-            task.struck[e] = False
-        elif kind == EVENT_LIFTOFF:
-            task.airborne[e] = True
-        elif kind == EVENT_APEX and task.airborne[e]:
-            h = events[k, EVENT_HEIGHT] - task.ground_height
-            task.apex_count[e] += 1
-            task.apex_error[e] += abs(h - task.target[e]) / task.target[e]
-            task.apex_height[e] = h
-            task.last_apex[e] = h
 
 
 @kernel(inline="always")
@@ -332,7 +181,7 @@ def step_env(
     """One control step of env ``e``: actuate with ``action`` in [-1, 1] (its gas ramp or strike in
     ``drive``), advance to its next control time, tally its flight apexes, then write its
     observation (``obs[e]``, unclipped; ``out[e]``, clipped to ``[low, high]`` as float32) and reward
-    and end (``task.reward``, ``task.end``, see :func:`_outcome`). ``ws`` and ``nodes`` are scratch,
+    and end (``task.reward``, ``task.end``, see :func:`outcome`). ``ws`` and ``nodes`` are scratch,
     carried over nothing."""
     me = env_model(model, e)
     se = env_state(state, e)
@@ -341,7 +190,7 @@ def step_env(
     task.apex_count[e] = 0
     task.apex_error[e] = 0.0
     task.apex_height[e] = 0.0
-    _actuate(me, se, de, task, e, action, clocks[e, CLOCK_T], ws, nodes)
+    actuate(me, se, de, task, e, action, clocks[e, CLOCK_T], ws, nodes)
     t_next = (task.steps[e] + 1) * task.control_dt
     rec = Recording(
         records.t[e], records.x[e], records.v[e], records.pressure[e], records.contact_force[e], events[e]
@@ -350,16 +199,16 @@ def step_env(
     while True:
         counters[e, COUNT_EVENTS] = 0
         status = advance(me, solver, ws, se, te, clocks[e], counters[e], t_next, t_next, NO_OUTPUT, rec, de)
-        _tally(task, e, events[e], counters[e, COUNT_EVENTS])
+        tally(task, e, events[e], counters[e, COUNT_EVENTS])
         if status != STATUS_BUFFER_FULL:
             break
     task.status[e] = status
     task.steps[e] += 1
-    task.rise[e] = _rise(me, se, task, e)
-    task.in_reach[e] = _paddle_ready(task, e, se.x[0], se.v[0])
+    task.rise[e] = rise(me, se, task, e)
+    task.in_reach[e] = paddle_ready(task, e, se.x[0], se.v[0])
     observe_env(model, state, task, e, obs[e])
     _clip(obs[e], low, high, out[e])
-    _outcome(task, e, obs[e], state.x.shape[1])
+    outcome(task, e, obs[e], state.x.shape[1])
 
 
 @kernel(nogil=True)
@@ -392,60 +241,10 @@ def _clip(row, low, high, out):
 
 
 @kernel
-def predicted_apex(task, e, row, n):
-    """Height (m) of the flight apex the reward measures, from env ``e``'s observation ``row``: while
-    the ball rises in flight, the centre of mass's ballistic apex ``y + v_y^2 / (2 g)`` (exact: only
-    gravity acts on the centre); otherwise (falling, or in contact) the last flight apex reached,
-    capped by the apex its free energy could still reach, ``r + rise``. So energy a bounce loses
-    lowers it at once, and energy put in (a paddle strike, the pump's work ``p dA``) counts from the
-    lift-off it leads to: what the next apex will be, not what the energy would give without the
-    bounce's loss."""
-    cy = row[field_start(OBS_CENTRE_OF_MASS_POSITION, n) + 1]
-    vy = row[field_start(OBS_CENTRE_OF_MASS_VELOCITY, n) + 1]
-    if task.airborne[e] and vy > 0.0:
-        return cy + 0.5 * vy * vy / task.gravity
-    return min(task.last_apex[e], task.rest_radius[e] + task.rise[e])
-
-
-@kernel
-def height_reward(error, margin):
-    """DeepMind Control's gaussian ``tolerance``: 1 at relative error 0, ``REWARD_AT_MARGIN`` at
-    ``margin``, ``exp(-(s error / margin)^2 / 2)`` with ``s = sqrt(-2 ln REWARD_AT_MARGIN)``; in
-    (0, 1]."""
-    x = REWARD_SCALE * error / margin
-    return math.exp(-0.5 * x * x)
-
-
-@kernel(inline="always")
-def _outcome(task, e, row, n):
-    """Reward and end of env ``e`` after a control step (see ``InflatedBallEnv``'s Rewards): the
-    :func:`height_reward` of the relative error ``|h - h_t| / h_t`` of the :func:`predicted_apex`
-    ``h``, 0 once the simulator failed; the episode ends when the ball rests, leaves the arena or
-    the simulator fails."""
-    centre = field_start(OBS_CENTRE_OF_MASS_POSITION, n)
-    cx = row[centre]
-    cy = row[centre + 1]
-    end = END_NONE
-    if task.status[e] != STATUS_DONE or cy < -1.0:
-        end = END_FAILURE
-    elif abs(cx) > task.arena_half_width or cy > task.arena_height:
-        end = END_ARENA
-    elif task.rise[e] < task.rest_height:
-        end = END_REST
-    target = task.target[e]
-    height = 0.0
-    if end != END_FAILURE:
-        height = height_reward(abs(predicted_apex(task, e, row, n) - target) / target, task.reward_margin)
-    task.end[e] = end
-    task.reward[e, REWARD_TOTAL] = height
-    task.reward[e, REWARD_HEIGHT] = height
-
-
-@kernel
 def observe_env(model, state, task, e, row):
     """Write env ``e``'s observation (the fields of ``observation.FIELDS``, unclipped) into ``row``."""
     n = state.x.shape[1]
-    nx, ny = model.grounds[0, 0], model.grounds[0, 1]
+    nx, ny = model.grounds[0, GROUND_NORMAL], model.grounds[0, GROUND_NORMAL + 1]
     x = state.x[e]
     v = state.v[e]
     cx, cy, ux, uy = centre_of_mass(x, v)
@@ -510,13 +309,10 @@ class BallBatch:
         self.scene = scene
         self.n_envs = n_envs
         self.n_nodes = scene.rings[0].n_nodes
-        self.model = _tiled_model(build_model(scene), n_envs)
+        self.model, self.solver, self.state, self.trial = build(scene, copies=n_envs)
         self.drive = build_drive(n_envs, self.n_nodes)  # each env's gas ramp and paddle strike
-        self.solver = build_solver(scene)
         barrier = bool(self.model.self_barrier)
         self.ws = self._scratch_workspace(barrier)
-        self.state = empty_state(n_envs, self.n_nodes)
-        self.trial = empty_state(n_envs, self.n_nodes)
         self.clocks = np.zeros((n_envs, N_CLOCK))
         self.counters = np.zeros((n_envs, N_COUNTERS), dtype=np.int64)
         shape = (n_envs, 1, 1, self.n_nodes, 2)
@@ -679,12 +475,3 @@ def compiled_entry(dispatcher: Any, args: tuple[Any, ...]) -> Callable[..., None
     if signature not in dispatcher.overloads:
         dispatcher.compile(signature)
     return dispatcher.overloads[signature].entry_point
-
-
-def _tiled_model(model: Model, n_envs: int) -> Model:
-    """``model`` of a one-ring scene with its per-ring arrays repeated for ``n_envs`` envs (the rings
-    of different envs never meet: this is not a scene of many rings)."""
-    tiled: dict[str, Any] = {
-        name: np.repeat(getattr(model, name), n_envs, axis=0) for name in PER_RING_FIELDS
-    }
-    return model._replace(**tiled)

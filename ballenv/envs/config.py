@@ -12,13 +12,14 @@ import numpy as np
 from gymnasium.error import ResetNeeded
 from numpy.typing import ArrayLike, NDArray
 
+from ballenv.physics.base.layout import STATUS_IMPULSE_AT_DT_MIN, STATUS_STEP_TOO_SMALL
+from ballenv.physics.base.ring import burst_pressure, inflation_ratio_of
+
 from ..physics import Ground, Ring, Scene
-from ..physics.layout import STATUS_IMPULSE_AT_DT_MIN, STATUS_STEP_TOO_SMALL
-from ..physics.ring import burst_pressure, inflation_ratio_of
 from ..physics.scene import check_choice, check_real
 from . import observation
-from .batch import END_FAILURE, MODE_PADDLE, MODE_PRESSURE, Task
 from .numerics import ENV_FIDELITIES, with_env_fidelity
+from .task import END_FAILURE, MODE_PADDLE, MODE_PRESSURE, Task
 
 ACTION_MODES = {"pressure": MODE_PRESSURE, "paddle": MODE_PADDLE}
 FAILURES = {

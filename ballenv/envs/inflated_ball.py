@@ -10,11 +10,13 @@ from gymnasium import Env, spaces
 from gymnasium.utils import EzPickle
 from numpy.typing import ArrayLike, NDArray
 
-from .batch import END_REASONS, REWARD, REWARD_TERMS, REWARD_TOTAL, BallBatch, observation_structure
+from ..physics.base.ring import total_mass
+from .batch import BallBatch, observation_structure
 from .config import BallEnvConfig, check_reset, draw_reset, failure_message, parse_actions
+from .task import END_REASONS, REWARD, REWARD_TERMS, REWARD_TOTAL
 
 if TYPE_CHECKING:
-    from ..render import BallRenderer
+    from .render import BallRenderer
 
 
 class InflatedBallEnv(Env[NDArray[np.float32], NDArray[np.float32]], EzPickle):
@@ -132,28 +134,9 @@ class InflatedBallEnv(Env[NDArray[np.float32], NDArray[np.float32]], EzPickle):
     | render_mode                 | str   | None           | "human" or "rgb_array"; one frame per control step, ``metadata["render_fps"]`` = control_frequency (real time) |
 
     ## Version History
-    - v3: the paddle strikes only a ball in flight (same observation layout, reward and pressure
-      mode, bit for bit; different paddle dynamics): on v2 the ground contact cleared the
-      once-per-flight flag while a squashing ball's centre still moved down, so for low targets
-      (whose paddle reaches down to a ball on the ground) ``paddle_in_reach`` was 1 on the ground
-      and a strike there gained ``v J`` at the landing speed: PPO's 27 such strikes in 100
-      held-out episodes gave next apexes off by 0.94 (median), against 0.024 for its 1,714
-      strikes in flight. v2 is no longer registered.
-    - v2: smooth actuation (same task, observation and reward; different dynamics): the gas amount
-      moves to the new setpoint as a linear ramp over the control step instead of a jump at its
-      start, and a paddle strike delivers its impulse at a constant rate over
-      ``paddle_strike_duration`` (new keyword, default 3 ms) instead of at once; both are stepped by
-      the simulator (``ballenv/physics/drive.py``). v1 is no longer registered.
-    - v1: numerics of the simulator changed (same physics, different numbers): the fidelity presets
-      use generalized-alpha with ``rho_infinity = 0.3`` (was 0.9), and the pressure and paddle
-      actions keep the integrator's carried acceleration instead of restarting it; random-action
-      episodes take 2-5x fewer Newton iterations. The reward is a per-step tolerance in [0, 1] of
-      the apex the ball is headed for (was: apex errors at the apexes, an optional shaping term,
-      a penalty per apex missed by ending early; ``apex_reward_weight``, ``shaping_reward_weight``,
-      ``termination_reward_weight`` and ``termination_horizon`` replaced by ``reward_margin``).
-      The observation gains ``pressure_setpoint`` (the pump's state) and ``last_apex`` (the
-      reward's memory; 5 N + 8 entries). The paddle strikes only a falling ball, once per flight
-      (was: at every step the ball's top was in reach). v0 is no longer registered.
+    - v3: the paddle strikes only a ball in flight, not one squashing on the ground (paddle dynamics; the observation, the reward and the pressure mode are as in v2). v2 is no longer registered.
+    - v2: smooth actuation: the gas amount ramps to its setpoint over the control step and a strike delivers its impulse over ``paddle_strike_duration`` (new keyword), both stepped by the simulator. v1 is no longer registered.
+    - v1: generalized-alpha presets with ``rho_infinity = 0.3`` and actions that keep the integrator's carried acceleration; a per-step tolerance reward of the apex the ball is headed for (``reward_margin`` replaces the v0 reward weights); the observation gains ``pressure_setpoint`` and ``last_apex``; the paddle strikes a falling ball once per flight. v0 is no longer registered.
     - v0: initial release.
     """
 
@@ -188,6 +171,29 @@ class InflatedBallEnv(Env[NDArray[np.float32], NDArray[np.float32]], EzPickle):
     def dt(self) -> float:
         """Control step (s)."""
         return self.config.control_dt
+
+    @property
+    def ball_mass(self) -> float:
+        """Mass of the ball (kg): its ring's wall, ``rho b h`` times its rest length."""
+        return total_mass(self.config.ring(self.config.initial_pressure))
+
+    @property
+    def apexes_last_step(self) -> int:
+        """Flight apexes the ball passed in the last control step (``info["apex_count"]``)."""
+        return int(self._batch.task.apex_count[0])
+
+    def planning_copies(self, n: int) -> BallBatch:
+        """``n`` copies of this env's ball for planning: a :class:`~ballenv.envs.batch.BallBatch` of
+        the same scene and task settings. Set them to this env's state with :meth:`copy_state_to`,
+        try actions with ``BallBatch.step(actions, running)`` and read ``BallBatch.task`` and
+        ``BallBatch.obs``."""
+        low, high = self.config.observation_bounds()
+        return BallBatch(self.config.scene(), n, self.config.task_settings(), low, high)
+
+    def copy_state_to(self, copies: BallBatch, rows: ArrayLike) -> None:
+        """Set envs ``rows`` of ``copies`` (:meth:`planning_copies`) to this env's simulator and task
+        state: from here each steps exactly as this env would, to the bit."""
+        copies.copy_env(self._batch, 0, rows)
 
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
@@ -235,7 +241,7 @@ class InflatedBallEnv(Env[NDArray[np.float32], NDArray[np.float32]], EzPickle):
             return None
         check_reset(self._has_reset, "render")
         if self._renderer is None:
-            from ..render import BallRenderer
+            from .render import BallRenderer
 
             self._renderer = BallRenderer(self.config, self.render_mode, self.metadata["render_fps"])
         return self._renderer.render(self._batch, 0)

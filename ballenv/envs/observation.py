@@ -12,17 +12,42 @@ is invalidated only by changes to ``batch.py`` itself: after changing a table, c
 """
 
 from collections.abc import Callable
-from typing import TYPE_CHECKING, NamedTuple
+from typing import NamedTuple, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ..physics.jit import kernel
+from ballenv.physics.base.jit import kernel
 
-if TYPE_CHECKING:
-    from .config import BallEnvConfig
 
-Bound = Callable[["BallEnvConfig"], "float | tuple[float, ...]"]  # config -> a number, or one per entry
+class Settings(Protocol):
+    """What the observation's bounds read of an env's settings (``config.BallEnvConfig`` is one)."""
+
+    @property
+    def n_nodes(self) -> int: ...
+
+    @property
+    def arena_half_width(self) -> float: ...  # m
+
+    @property
+    def arena_height(self) -> float: ...  # m
+
+    @property
+    def initial_pressure(self) -> float: ...  # Pa
+
+    @property
+    def pressure_range(self) -> tuple[float, float]: ...  # Pa
+
+    @property
+    def target_height_range(self) -> tuple[float, float]: ...  # m
+
+    @property
+    def paddle_max_impulse(self) -> float: ...  # N s
+
+    def largest_radius(self) -> float: ...  # m
+
+
+Bound = Callable[[Settings], "float | tuple[float, ...]"]  # config -> a number, or one per entry
 
 MAX_SPEED = 100.0  # m/s, bound of the velocity observations
 MAX_NODE_FORCE = 1e5  # N, bound of the per-node ground normal force observation
@@ -34,7 +59,7 @@ SUNK_HEIGHT = -1.0  # m, lowest centre-of-mass height observed (the simulator ha
 class Field(NamedTuple):
     """One named part of the observation vector: ``per_node * N + fixed`` entries for a ring of N
     nodes, bounded by ``low(config)`` and ``high(config)`` (a number, or one per entry) in ``unit``;
-    ``config`` is the env's ``BallEnvConfig``."""
+    ``config`` is the env's settings (:class:`Settings`)."""
 
     name: str
     per_node: int
@@ -49,7 +74,7 @@ class Field(NamedTuple):
         return self.per_node * n_nodes + self.fixed
 
 
-def _node_reach(config: "BallEnvConfig") -> float:
+def _node_reach(config: Settings) -> float:
     """Farthest a node can be from the centre of mass (m): four times the largest inflated radius."""
     return 4.0 * config.largest_radius()
 
@@ -158,7 +183,7 @@ def structure(n_nodes: int, paddle: bool) -> dict[str, slice]:
     return out
 
 
-def bounds(config: "BallEnvConfig", paddle: bool) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
+def bounds(config: Settings, paddle: bool) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
     """(low, high) float32 bounds of the observation vector of the env configured by ``config``."""
     n = config.n_nodes
     parts = structure(n, paddle)

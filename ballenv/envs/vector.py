@@ -20,20 +20,13 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 from numpy.typing import ArrayLike, NDArray
 
-from .batch import (
-    END_FAILURE,
-    END_REASONS,
-    REWARD,
-    REWARD_TERMS,
-    REWARD_TOTAL,
-    BallBatch,
-    observation_structure,
-)
+from .batch import BallBatch, observation_structure
 from .config import BallEnvConfig, check_reset, draw_reset, failure_message, parse_actions
 from .inflated_ball import InflatedBallEnv
+from .task import END_FAILURE, END_REASONS, REWARD, REWARD_TERMS, REWARD_TOTAL
 
 if TYPE_CHECKING:
-    from ..render import BallRenderer
+    from .render import BallRenderer
 
 DEFAULT_MAX_EPISODE_STEPS = 1000
 
@@ -186,7 +179,7 @@ class InflatedBallVectorEnv(VectorEnv[NDArray[np.float32], NDArray[np.float32], 
             return None
         check_reset(self._has_reset, "vector render")
         if self._renderer is None:
-            from ..render import BallRenderer
+            from .render import BallRenderer
 
             self._renderer = BallRenderer(self.config, "rgb_array", self.metadata["render_fps"])
         frames = (self._renderer.render(self._batch, i) for i in range(self.num_envs))

@@ -1,9 +1,9 @@
 """The inflated-ring simulator: pure numerics (NumPy + numba), no gymnasium, no torch."""
 
-from .compile_notice import install as _install_compile_notice
+from .base.compile_notice import install as _install_compile_notice
 from .scene import Drum, Ground, Ring, Scene
-from .simulate import simulate
-from .simulation import Simulation, SimulationError, SimulationStats, Trajectory, energy
+from .simulation import Simulation, SimulationError, simulate
+from .trajectory import SimulationStats, Trajectory, energy
 
 __all__ = [
     "Drum",

@@ -7,26 +7,23 @@ whose adaptive step keeps the error within the relative tolerance ``rtol`` (``Sc
 integrator's local error estimate on the nodes' positions at most ``rtol R``, and the contact
 impulse per step at most ``rtol M sqrt(g R)``, ``M`` the ring's mass and ``R`` its radius):
 
-=========  ======  =====  ==========  ==========  ====================  ==================  ===========
-preset     nodes   rtol   largest dt  newton_tol  first-apex error      measured worst      wall, 1 s
-=========  ======  =====  ==========  ==========  ====================  ==================  ===========
-fast       32      0.1    0.02 s      1e-6        bound 3 %             0.9 %               4-10 ms
-balanced   64      0.02   0.01 s      1e-9        bound 1 %             0.6 %               21-59 ms
-accurate   128     0.003  0.005 s     1e-10       bound 0.3 %           0.16 %              161-610 ms
-=========  ======  =====  ==========  ==========  ====================  ==================  ===========
+=========  ======  =====  ==========  ==========  ===========================
+preset     nodes   rtol   largest dt  newton_tol  first-apex error (bound)
+=========  ======  =====  ==========  ==========  ===========================
+fast       32      0.1    0.02 s      1e-6        3 %
+balanced   64      0.02   0.01 s      1e-9        1 %
+accurate   128     0.003  0.005 s     1e-10       0.3 %
+=========  ======  =====  ==========  ==========  ===========================
 
-The error is that of the step control: the first-apex height of the six balls of
+The bound is on the error of the step control: the first-apex height of each of the six balls of
 ``benchmarks/ball_family.py`` (3 g to 500 g, gas-to-bending stiffness ratio 1.9 to 7,800, flat
 floor and slope, with and without friction) against a converged run of the same ball at the same
-node count; ``benchmarks/accuracy.py`` measures it (with the wall time of the 1-s drop) and
-``tests/physics/test_presets.py`` checks every preset's bound on every ball. The node count is a
-separate choice with its own error, the polygon's: the converged first apex moves by up to 5 %
-from N = 32 to N = 64 and up to 1.2 % from 64 to 128 (the bending-dominated ball; the table
-``benchmarks/results/accuracy.md`` gives every ball's). ``rho_infinity = 0.3`` (the Scene default
-is 0.9) damps the wall's modes above what the step resolves, which cost Newton iterations and
-rejected steps when left ringing: at N = 64 and the same ``rtol`` the runs take 1.5-2x less wall
-time than with 0.9, and the worst error over the six balls differs by at most 2.7x either way
-(0.85 / 0.26 / 0.33 % against 0.72 / 0.70 / 0.14 % at rtol 0.03 / 0.01 / 0.003).
+node count. ``tests/physics/test_presets.py`` checks every preset's bound on every ball;
+``benchmarks/accuracy.py`` measures the errors and the wall time of a 1-s drop
+(``benchmarks/results/accuracy.md``). The node count is a separate choice with its own error, the
+polygon's, which the same page gives for every ball. ``rho_infinity = 0.3`` (the Scene default is
+0.9) damps the wall's modes above what the step resolves, which would otherwise cost Newton
+iterations and rejected steps.
 
 InflatedBall-v3's ``fidelity`` keyword keeps the settings its dynamics were defined with
 (:mod:`ballenv.envs.numerics`).

@@ -12,8 +12,7 @@ from dataclasses import dataclass, field
 from numbers import Integral, Real
 from typing import Any, NoReturn, TypeVar
 
-from .effects import scene_effects
-from .ring import burst_pressure, crush_pressure
+from .base.ring import burst_pressure, crush_pressure
 
 INTEGRATORS = ("backward_euler", "generalized_alpha")
 DAMPING_MODES = ("rigid", "centre_of_mass")
@@ -189,7 +188,7 @@ class Ground:
 
     The surface moves with a constant ``velocity`` u plus an oscillation along its normal n, so
     that its offset along n is ``d(t) = d0 + n . u t + A sin(2 pi f t)`` and its velocity
-    ``w(t) = u + A 2 pi f cos(2 pi f t) n`` (``ballenv.physics.ground_motion``). A node in contact
+    ``w(t) = u + A 2 pi f cos(2 pi f t) n`` (``ballenv.physics.ground.motion``). A node in contact
     ends each step on the surface with the surface's normal velocity; Coulomb friction acts on its
     velocity relative to the surface.
 
@@ -240,10 +239,10 @@ class Drum:
     The rings stay in ``R - |x - c| >= 0`` (``inside``) or ``|x - c| - R >= 0`` (outside: a round
     obstacle). The drum turns about its fixed centre ``c`` at the angular velocity (rad/s,
     counter-clockwise positive) ``Omega(t) = Omega_0 min(1, t / T)`` after a spin-up over ``T`` s
-    (``ballenv.physics.ground_motion``), so its surface at ``x`` moves with
+    (``ballenv.physics.ground.motion``), so its surface at ``x`` moves with
     ``w = Omega e_z x (x - c)``, along the surface. A node in contact ends each step on the circle;
     Coulomb friction acts on its velocity relative to ``w``, and the work the turning drum does
-    through it is credited to the energy budget (``energy.boundary_work``).
+    through it is credited to the energy budget (``step.energy_budget.boundary_work``).
 
     Attributes:
         radius: radius R (m) of the circle, in (0, 1e6].
@@ -315,23 +314,22 @@ class Scene:
             ``rtol`` > 0 is given too, which is an error). The impulse is a ring's total ground
             reaction over the step, net of the momentum that stops nodes moving into the ground at
             the step's start (arriving ones, or resting ones a collision impulse pushed; see
-            ``stepper.try_step``); larger steps are rejected and shrunk by the ratio, smaller ones
+            ``step.stepper.try_step``); larger steps are rejected and shrunk by the ratio, smaller ones
             grow by at most x1.25.
         rtol: error control of the adaptive step, dimensionless in [0, 1]; None (default): 0.01
             (``DEFAULT_RTOL``) unless ``impulse_tol`` is given, then 0 (``step_rtol`` is the value in
             use). Above 0, every step keeps two measures within it: the local error estimate of the
-            integrator (``local_error.py``), its RMS over a ring's nodes at most ``atol + rtol R``
+            integrator (``step/local_error.py``), its RMS over a ring's nodes at most ``atol + rtol R``
             (m, ``R`` the ring's radius), and the error in contact as ``contact_error`` says, so the
             same ``rtol`` asks the same relative accuracy of a 3 g ring and a 500 g ball. What it
-            achieves on six balls: ``benchmarks/accuracy.py`` (the default's first-apex error
-            0.009-0.46 % on them, in 10-31 % of the wall time of fixed 0.1 ms steps).
+            achieves on six balls: ``benchmarks/accuracy.py`` (``benchmarks/results/accuracy.md``).
         contact_error: how ``rtol`` controls a step with a node on a ground at either end.
             "impulse" (default): the contact impulse (as for ``impulse_tol``) at most
             ``rtol M sqrt(g R)`` (N s, ``M`` the ring's mass: the momentum of the ring falling its own
             radius), and the step of a ring in flight ends at its predicted first touch of a ground
-            (``touchdown.py``). "doubling": the contact errors of ``contact_error.py`` (the distance arriving
-            nodes still had to go, the step doubling of the ring's rigid motion, the contact impulse
-            at most ``2 sqrt(rtol) M sqrt(g R)``): an error closer to proportional to ``rtol``
+            (``ground/touchdown.py``). "doubling": the contact errors of ``step/contact_error.py`` (the
+            distance arriving nodes still had to go, the step doubling of the ring's rigid motion, the contact
+            impulse at most ``2 sqrt(rtol) M sqrt(g R)``): an error closer to proportional to ``rtol``
             (0.06-3.5 ``rtol`` on the six balls against 0.004-0.91, monotone on five of them against
             four), at about the same or more wall time than "impulse" for the same achieved error on
             five of the six (the stiff hoop: less).
@@ -352,10 +350,9 @@ class Scene:
         adaptive: True (default): adapt the step to the error (``rtol``) or the contact impulse
             (``impulse_tol``): a step above either is rejected and shrunk, accepted steps grow it
             by at most x1.25 back up to ``dt``. False: fixed steps ``dt`` (choose it: the default
-            0.01 s is a largest step).
-            Either way a rejected step (Newton failure, energy gain, intrusion, self-intersection) is
-            retried with half the step; fixed, a halved step doubles back after each accepted step
-            until it is ``dt`` again.
+            0.01 s is a largest step). Either way a rejected step (Newton failure, energy gain, intrusion,
+            self-intersection) is retried with half the step; fixed, a halved step doubles back after each
+            accepted step until it is ``dt`` again.
         dt_min: smallest step (s) before simulate() gives up with SimulationError, in (0, dt].
         newton_tol: Newton tolerance on the residual relative to the forces it balances
             (dimensionless), in [1e-14, 1e-2].
@@ -375,14 +372,14 @@ class Scene:
         ring_collision: rings push each other apart when a node comes within the contact distance
             ``h_a + h_b`` of another ring's centreline; only with two or more rings. With
             ``self_intersection = "barrier"`` through a barrier potential inside one implicit step
-            of the rings in contact (``ring_contact.py``, ``ring_newton.py``), otherwise through
-            explicit impulses (``collision.py``). False lets rings pass through each other.
+            of the rings in contact (``walls/ring_barrier.py``, ``step/joint_newton.py``), otherwise through
+            explicit impulses (``walls/impulses.py``). False lets rings pass through each other.
         self_intersection: "barrier" (default: "reject", and wall parts of a ring far apart
             along it repel through a barrier potential inside the implicit step, with continuous
             collision detection on the Newton iterates, so a squashed ring rests folded;
-            ``barrier.py``; and a node folding shut or an edge collapsing meets a barrier of its
-            own, ``wall_limits.py``), "reject" (wall parts of a ring within a few edges of each other along
-            the ring push apart like two rings, and a trial state in which a ring's polygon crosses
+            ``walls/self_barrier.py``; and a node folding shut or an edge collapsing meets a barrier of its
+            own, ``walls/wall_limits.py``), "reject" (wall parts of a ring within a few edges of each other
+            along the ring push apart like two rings, and a trial state in which a ring's polygon crosses
             itself is rejected and the step retried smaller; at ``dt_min`` simulate() stops with
             SimulationError) or "ignore" (neither).
     """
@@ -483,9 +480,3 @@ class Scene:
         if isinstance(self.gravity, tuple):
             return self.gravity
         return (0.0, -self.gravity)
-
-    @property
-    def effects(self) -> tuple[str, ...]:
-        """Names of the effects this scene switches on (stretching and bending always are), from the
-        registry ``ballenv.physics.effects``."""
-        return scene_effects(self)

@@ -1,20 +1,17 @@
 """The one driver of a simulation: build a scene once, advance it, actuate it, read it.
 
 :class:`Simulation` owns a scene's compiled arrays (``Model``, ``Solver``, ``State``, workspace,
-clock, counters and the recording) and advances them with :func:`stepper.advance`; between
-advances the gas amount of a ring can be set and impulses applied (:mod:`.actuation`), exactly
-as the env does. :func:`ballenv.physics.simulate` is a Simulation run once to its end; the scenes
+clock, counters and the recording) and advances them with :func:`step.stepper.advance`; between
+advances the gas amount of a ring can be set and impulses applied (:mod:`ballenv.physics.step.actuation`),
+exactly as the env does. :func:`ballenv.physics.simulate` is a Simulation run once to its end; the scenes
 that actuate between bounces drive one directly. :class:`SimulationStats` and :class:`Trajectory`
 are read off it.
 """
 
 from __future__ import annotations
 
-import os
-import pathlib
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass, field
 from numbers import Integral
 from types import ModuleType
 from typing import TYPE_CHECKING, Any
@@ -22,22 +19,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import ring as ring_geometry
-from .actuation import (
-    apply_impulse,
-    hold_gas,
-    ramp_rest_pressure,
-    set_rest_pressure,
-    spread_impulse,
-)
-from .assembly import ENERGY_PARTS, ring_energy
-from .collision import find_contacts, self_intersects
-from .effects import EFFECTS, scene_effects
-from .energy import self_contact_energy
-from .events import event_list
-from .geometry import polygon_area
-from .integrator import build_solver
-from .layout import (
+from .base import ring as ring_geometry
+from .base.geometry import polygon_area
+from .base.layout import (
     CLOCK_BOUNDARY_WORK,
     CLOCK_COLLISION_GAIN,
     CLOCK_ENERGY_REMOVED,
@@ -53,11 +37,6 @@ from .layout import (
     COUNT_REJECTED,
     COUNT_REJECTION,
     COUNT_STEPS,
-    EVENT_APEX,
-    EVENT_HEIGHT,
-    EVENT_KIND,
-    EVENT_RING,
-    EVENT_T,
     GROUND_CENTRE,
     GROUND_DRUM_INSIDE,
     GROUND_KIND,
@@ -73,23 +52,22 @@ from .layout import (
     STATUS_IMPULSE_AT_DT_MIN,
     STATUS_STEP_TOO_SMALL,
 )
-from .model import (
-    CONTACT_NONE,
-    Drive,
-    Model,
-    Recording,
-    Workspace,
-    build_barrier_workspace,
+from .build import (
+    build,
     build_drive,
-    build_model,
-    build_ring_contact_workspace,
-    build_workspace,
     empty_recording,
-    empty_state,
+    initial_state,
+    scene_effects,
+    simulation_workspace,
 )
-from .ring_contact import contact_energy_by_ring, pairs_per_node
+from .effects import EFFECTS
+from .model import Drive, Model, Recording, Workspace
 from .scene import Scene, check_gauge_pressure, check_real, check_vector
-from .stepper import advance, initial_state_values, record
+from .step.actuation import apply_impulse, hold_gas, ramp_rest_pressure, set_rest_pressure, spread_impulse
+from .step.events import event_list
+from .step.stepper import advance, initial_state_values, record
+from .trajectory import SimulationStats, Trajectory
+from .walls.impulses import find_contacts, self_intersects
 
 if TYPE_CHECKING:
     from tqdm.auto import tqdm
@@ -110,144 +88,6 @@ class SimulationError(RuntimeError):
     def __init__(self, message: str, trajectory: Trajectory | None = None) -> None:
         super().__init__(message)
         self.trajectory = trajectory
-
-
-@dataclass(frozen=True)
-class SimulationStats:
-    """Cost of a run: accepted and rejected steps, Newton iterations (linear solves), wall time (s);
-    ``rejections`` counts the rejected steps by reason ("newton", "energy", "intrusion",
-    "self_intersection", "impulse": the adaptive step's contact impulse above its bound, "error": the
-    local error above ``Scene.rtol``, ``atol``);
-    ``energy_projected``: accepted (step, ring) pairs whose energy rose above the ring's budget (its
-    start energy plus the work of actuation and collisions) by a small step error, removed from the
-    ring's velocities relative to its centre of mass; ``energy_removed`` (J): the sum of those
-    excesses (``energy.within_energy_budget``); ``collision_gain`` (J): the energy ring-ring and
-    self-contact impulses created by pushing out nodes that started a step inside the contact
-    distance, summed over the steps where their net effect was a gain (a source of energy besides
-    actuation); ``boundary_work`` (J): the work moving grounds did on the rings,
-    ``sum_steps h sum_i f_i . w`` (``energy.boundary_work``; 0 with fixed grounds), which their
-    energy budgets are credited with; ``newton_rescues``: steps taken by Newton's rescue after a
-    stop at ``dt_min`` (``Scene.newton_rescue_max_iter``)."""
-
-    steps: int
-    rejected_steps: int
-    newton_iterations: int
-    wall_time: float
-    effects: tuple[str, ...]
-    integrator: str
-    rejections: dict[str, int] = field(default_factory=dict)  # rejected steps by reason (layout.REJECTIONS)
-    energy_projected: int = 0
-    energy_removed: float = 0.0
-    collision_gain: float = 0.0
-    boundary_work: float = 0.0
-    newton_rescues: int = 0
-
-
-@dataclass
-class Trajectory:
-    """Recorded states of a simulation (SI units).
-
-    Attributes:
-        t: (T,) time (s).
-        x: (T, n_rings, n_nodes, 2) node positions (m).
-        v: (T, n_rings, n_nodes, 2) node velocities (m/s).
-        pressure: (T, n_rings) gauge pressure (Pa); 0 for rings without gas.
-        contact_force: (T, n_rings, n_nodes, 2) ground reaction (N); zero without grounds.
-        events: list of (t, ring, kind) with kind in {"touchdown", "liftoff", "apex"}.
-        stats: :class:`SimulationStats`.
-        scene: the simulated :class:`Scene`.
-    """
-
-    t: NDArray[np.float64]
-    x: NDArray[np.float64]
-    v: NDArray[np.float64]
-    pressure: NDArray[np.float64]
-    contact_force: NDArray[np.float64]
-    events: list[tuple[float, int, str]]
-    stats: SimulationStats
-    scene: Scene = field(repr=False)
-    event_table: NDArray[np.float64] | None = field(default=None, repr=False)
-
-    def apexes(self, ring: int = 0) -> NDArray[np.float64]:
-        """(k, 2) array of (t (s), centre-of-mass height (m)) at the apexes of ``ring``,
-        interpolated inside the step (cubic Hermite), not sampled."""
-        rows = self.event_table
-        if rows is None or len(rows) == 0:
-            return np.zeros((0, 2))
-        sel = (rows[:, EVENT_RING] == ring) & (rows[:, EVENT_KIND] == EVENT_APEX)
-        return rows[sel][:, [EVENT_T, EVENT_HEIGHT]]
-
-    def centre_of_mass(self) -> NDArray[np.float64]:
-        """(T, n_rings, 2) centre of mass (m); nodes of a ring have equal mass."""
-        return self.x.mean(axis=2)
-
-    def energy(self) -> dict[str, NDArray[np.float64]]:
-        """Energy (J) per record and ring: dict of (T, n_rings) arrays.
-
-        Keys: kinetic, stretching, bending, gas (the gas-law potential), gravity, with the self-contact
-        barrier (``Scene.self_intersection = "barrier"``) self_contact, with rings colliding through
-        it ring_contact (each node-edge pair's barrier energy, half to either ring), and total. Computed with
-        the scene's gas amounts and the registry's effects: records after a
-        :meth:`Simulation.set_rest_pressure` hold another amount of gas than this counts.
-        """
-        return energy(self.scene, self.x, self.v)
-
-    def save(self, path: str | os.PathLike[str]) -> pathlib.Path:
-        """Write this trajectory to ``path`` (a compressed ``.npz``; layout in
-        :mod:`ballenv.physics.trajectory_io`); returns the path written."""
-        from .trajectory_io import save
-
-        return save(self, path)
-
-    @classmethod
-    def load(cls, path: str | os.PathLike[str]) -> Trajectory:
-        """A trajectory saved by :meth:`save`, exactly as it was (ValueError on a foreign file)."""
-        from .trajectory_io import load
-
-        return load(path)
-
-
-def energy(scene: Scene, x: ArrayLike, v: ArrayLike) -> dict[str, NDArray[np.float64]]:
-    """Mechanical plus gas energy (J) of states ``x, v`` (..., n_rings, n_nodes, 2); see Trajectory."""
-    model = build_model(scene)
-    x = np.asarray(x, dtype=float)
-    v = np.asarray(v, dtype=float)
-    lead = x.shape[:-2]
-    xs = np.ascontiguousarray(x.reshape(-1, x.shape[-2], 2))
-    vs = np.ascontiguousarray(v.reshape(-1, x.shape[-2], 2))
-    n_rings = len(scene.rings)
-    names = ENERGY_PARTS + (("self_contact",) if model.self_barrier else ())
-    table = np.zeros((xs.shape[0], len(names)))
-    bw = build_barrier_workspace(xs.shape[1]) if model.self_barrier else None
-    for k in range(xs.shape[0]):
-        ring_energy(model, k % n_rings, xs[k], vs[k], table[k])
-        if bw is not None:
-            table[k, -1] = self_contact_energy(model, k % n_rings, xs[k], bw)
-    out = {name: table[:, j].reshape(lead) for j, name in enumerate(names)}
-    total = table.sum(axis=1).reshape(lead)
-    if model.ring_barrier:
-        between = _contact_energy_by_ring(model, xs.reshape(-1, n_rings, xs.shape[1], 2)).reshape(lead)
-        out["ring_contact"] = between
-        total = total + between
-    out["total"] = total
-    return out
-
-
-def _contact_energy_by_ring(model: Model, states: NDArray[np.float64]) -> NDArray[np.float64]:
-    """(T, R): the barrier energy (J) between rings of each state (T, R, N, 2), each pair's half to
-    either ring."""
-    rw = build_ring_contact_workspace(states.shape[1], states.shape[2], pairs_per_node(model))
-    out = np.zeros(states.shape[:2])
-    for k, x in enumerate(states):
-        x = np.ascontiguousarray(x)
-        contact_energy_by_ring(model, x, rw, out[k])
-    return out
-
-
-def initial_state(scene: Scene) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Node positions and velocities (R, N, 2) of the scene's rings at t = 0."""
-    pairs = [ring_geometry.initial_nodes(r) for r in scene.rings]
-    return np.stack([p[0] for p in pairs]), np.stack([p[1] for p in pairs])
 
 
 class Simulation:
@@ -290,26 +130,9 @@ class Simulation:
         self.scene = scene
         self.effects = tuple(effects)
         self.output_dt = output_dt
-        self.model = build_model(scene, effects)
-        self.solver = build_solver(scene)
+        self.model, self.solver, self.state, self.trial = build(scene, effects)
+        self.ws = simulation_workspace(scene, self.model, self.solver, effects)
         n_rings, n_nodes = len(scene.rings), scene.rings[0].n_nodes
-        self.ws = build_workspace(
-            n_nodes,
-            n_rings,
-            effects,
-            barrier=self.model.self_barrier,
-            ring_pairs=self.model.collide,
-            ring_contact=self.model.ring_barrier,
-            contact_pairs_per_node=pairs_per_node(self.model),
-            n_grounds=len(scene.grounds) + len(scene.drums),
-            doubling=(
-                self.solver.rtol > 0.0
-                and scene.contact_error == "doubling"
-                and self.model.contact_method != CONTACT_NONE
-            ),
-        )
-        self.state = empty_state(n_rings, n_nodes)
-        self.trial = empty_state(n_rings, n_nodes)
         shape = (n_rings, n_nodes, 2)
         x_init, v_init = initial_state(scene)
         self.state.x[:] = _check_state(caller, "x0", x0, shape) if x0 is not None else x_init
@@ -454,11 +277,11 @@ class Simulation:
 
     def set_rest_pressure(self, ring: int, pressure: float, duration: float = 0.0) -> None:
         """Set ring ``ring``'s gas to the amount whose gauge pressure at rest is ``pressure`` (Pa)
-        (:func:`actuation.set_rest_pressure`), in the range ``Ring.pressure`` and the scene's atmosphere
+        (:func:`step.actuation.set_rest_pressure`), in the range ``Ring.pressure`` and the scene's atmosphere
         allow (:func:`scene.check_gauge_pressure`); the ring must hold gas. ``duration`` (s): 0 sets
         it at once; longer moves the amount linearly in time from the present one to it over
-        ``[t, t + duration]`` (a gas ramp, :mod:`.drive`: each step holds the amount of its
-        force-evaluation time, steps land on the ramp's end, where the amount is the new one
+        ``[t, t + duration]`` (a gas ramp, :mod:`ballenv.physics.step.actuation`: each step holds the amount
+        of its force-evaluation time, steps land on the ramp's end, where the amount is the new one
         exactly), replacing a ramp under way."""
         owner = "Simulation.set_rest_pressure"
         ring = self._ring_index(owner, ring)
@@ -482,8 +305,8 @@ class Simulation:
         """Add momentum ``impulse`` (N s, a pair, each at most 1e3 N s) to ring ``ring``, shared
         equally by ``nodes`` (distinct node indices of the ring). ``duration`` (s): 0 adds it at
         once; longer delivers it at a constant rate over ``[t, t + duration]`` (a spread impulse,
-        :mod:`.drive`: exactly ``impulse`` whatever the steps, the last one landing on the window's
-        end), replacing a spread impulse of the ring under way."""
+        :mod:`ballenv.physics.step.actuation`: exactly ``impulse`` whatever the steps, the last one landing on
+        the window's end), replacing a spread impulse of the ring under way."""
         owner = "Simulation.apply_impulse"
         ring = self._ring_index(owner, ring)
         n_nodes = self.scene.rings[0].n_nodes
@@ -664,3 +487,39 @@ def progress_bar(t_end: float, start: float = 0.0) -> tqdm[Any]:
         desc="simulate",
         bar_format="{l_bar}{bar}| {n:.3g}/{total:.3g} s [{elapsed}<{remaining}]",
     )
+
+
+def simulate(
+    scene: Scene,
+    t_end: float,
+    x0: ArrayLike | None = None,
+    v0: ArrayLike | None = None,
+    output_dt: float | None = None,
+    progress: bool = False,
+) -> Trajectory:
+    """Simulate ``scene`` from t = 0 to ``t_end`` (s).
+
+    Args:
+        scene: the :class:`Scene`.
+        t_end: end time (s), in (0, 1e6].
+        x0, v0: optional initial node positions (m) and velocities (m/s), shape (n_rings, n_nodes, 2)
+            (or (n_nodes, 2) for one ring); default: the rings' circles and rigid motions. Each ring
+            of ``x0`` must be a simple polygon with its nodes counter-clockwise and no two
+            neighbours at the same place (ValueError otherwise, before anything is compiled).
+        output_dt: record interval (s); None records every accepted step.
+        progress: show a progress bar (tqdm) over simulated time.
+
+    Returns:
+        Trajectory. Raises SimulationError (with the trajectory up to the failure) if the step size
+        falls below ``scene.dt_min``.
+    """
+    if not isinstance(scene, Scene):
+        raise ValueError(f"simulate.scene = {scene!r} is invalid: must be a ballenv.physics.Scene")
+    t_end = check_real("simulate", "t_end", t_end, 0.0, 1e6, "s", low_open=True)
+    if output_dt is not None:
+        output_dt = check_real("simulate", "output_dt", output_dt, 0.0, t_end, "s", low_open=True)
+    sim = Simulation(scene, x0, v0, output_dt, expected_end=t_end, caller="simulate")
+    if not sim.advance(t_end, progress):
+        assert sim.failure is not None  # advance() says why it stopped
+        raise SimulationError(sim.failure, sim.trajectory())
+    return sim.trajectory()

@@ -12,11 +12,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ballenv.physics import Drum, Ground, Ring, Scene, Simulation, SimulationError, simulate
+from ballenv.physics.base.ring import bending_stiffness, inflated_radius, total_mass
+from ballenv.physics.step.events import event_list
+
 from ..cluster import collect, run_tasks
-from ..physics import Drum, Ground, Ring, Scene, Simulation, SimulationError, simulate
-from ..physics.events import event_list
 from ..physics.presets import with_fidelity
-from ..physics.ring import bending_stiffness, inflated_radius, total_mass
 from ..physics.simulation import progress_bar
 
 G = 9.81  # m/s^2

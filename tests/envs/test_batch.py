@@ -12,17 +12,16 @@ import ballenv  # noqa: F401  (registers the env)
 from ballenv.controllers import PaddleDribble, PressurePump
 from ballenv.envs.batch import (
     ENVS_PER_LINE,
-    REWARD_AT_MARGIN,
     BallBatch,
     env_model,
     guided_chunks,
-    height_reward,
 )
 from ballenv.envs.inflated_ball import InflatedBallEnv
-from ballenv.physics.actuation import set_gas
-from ballenv.physics.layout import CLOCK_T, PUSH_DELIVERED, PUSH_T_END, PUSH_T_START, RAMP_T_END
-from ballenv.physics.model import build_workspace
-from ballenv.physics.ring import total_mass
+from ballenv.envs.task import REWARD_AT_MARGIN, height_reward
+from ballenv.physics.base.layout import CLOCK_T, PUSH_DELIVERED, PUSH_T_END, PUSH_T_START, RAMP_T_END
+from ballenv.physics.base.ring import total_mass
+from ballenv.physics.build import build_workspace
+from ballenv.physics.step.actuation import set_gas
 
 MODES = ("pressure", "paddle")
 

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from ballenv.physics.linalg import BAND_COLUMNS, MAX_LOW_RANK, band_to_dense, zigzag_positions
+from ballenv.physics.base.linalg import BAND_COLUMNS, MAX_LOW_RANK, band_to_dense, zigzag_positions
 
 
 def deformed_ring(n_nodes, radius=0.1, amplitude=0.02, seed=0):

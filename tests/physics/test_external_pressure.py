@@ -14,9 +14,9 @@ import numpy as np
 import pytest
 
 from ballenv.physics import Ring, Scene, Simulation, simulate
-from ballenv.physics.geometry import polygon_area
-from ballenv.physics.layout import ENERGY_BUDGET, ENERGY_TOTAL
-from ballenv.physics.ring import bending_stiffness, initial_nodes
+from ballenv.physics.base.geometry import polygon_area
+from ballenv.physics.base.layout import ENERGY_BUDGET, ENERGY_TOTAL
+from ballenv.physics.base.ring import bending_stiffness, initial_nodes
 
 N = 64
 WALL = dict(radius=0.1, n_nodes=N, youngs_modulus=10e6, thickness=5e-3, width=0.02, density=1100.0)

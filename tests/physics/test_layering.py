@@ -19,12 +19,12 @@ SCRIPT = textwrap.dedent(
 
     sys.meta_path.insert(0, Blocker())
     import ballenv.physics as physics
-    from ballenv.physics.model import build_model
+    from ballenv.physics.build import build_model, scene_effects
 
     ground = physics.Ground(friction=0.5)
     scene = physics.Scene(rings=[physics.Ring(n_nodes=8)], grounds=[ground], damping=1.0)
     build_model(scene)
-    assert scene.effects[-2:] == ("ground", "friction"), scene.effects
+    assert scene_effects(scene)[-2:] == ("ground", "friction"), scene_effects(scene)
     loaded = sorted(m for m in sys.modules if m.split(".")[0] in {BLOCKED!r})
     assert not loaded, loaded
     print("ok")

@@ -5,8 +5,9 @@ import math
 import pytest
 
 from ballenv.physics import Ring, Scene, simulate
-from ballenv.physics.integrator import build_solver
+from ballenv.physics.build import scene_effects
 from ballenv.physics.scene import DEFAULT_RTOL
+from ballenv.physics.step.integrator import build_solver
 
 
 @pytest.mark.parametrize(
@@ -121,6 +122,6 @@ def test_simulate_rejects_wrong_initial_state_shape_and_nan():
 
 def test_effects_name_only_what_the_scene_asks_for():
     bare = Scene(rings=[Ring(pressure=None)], gravity=0.0)
-    assert bare.effects == ("stretching", "bending")
+    assert scene_effects(bare) == ("stretching", "bending")
     full = Scene(rings=[Ring(pressure=0.0)], gravity=9.81, damping=1.0)
-    assert full.effects == ("stretching", "bending", "pressure", "gravity", "damping")
+    assert scene_effects(full) == ("stretching", "bending", "pressure", "gravity", "damping")

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from ballenv.physics import Ring, Scene, SimulationError, energy, simulate
-from ballenv.physics.geometry import polygon_area
-from ballenv.physics.ring import inflated_radius
+from ballenv.physics.base.geometry import polygon_area
+from ballenv.physics.base.ring import inflated_radius
 
 E, RHO, R = 10e6, 1100.0, 0.1
 BREATHING_OMEGA = math.sqrt(E / RHO) / R  # rad/s

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from ballenv.physics import Ground, Ring, Scene, Simulation, simulate
-from ballenv.physics.layout import ENERGY_BUDGET, ENERGY_TOTAL
-from ballenv.physics.simulation import initial_state
+from ballenv.physics.base.layout import ENERGY_BUDGET, ENERGY_TOTAL
+from ballenv.physics.build import initial_state
 from tests.stability.invariants import audit
 
 

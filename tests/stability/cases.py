@@ -12,7 +12,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ballenv.physics import Ground, Ring, Scene
-from ballenv.physics.ring import inflated_radius
+from ballenv.physics.base.ring import inflated_radius
 
 CONTACTS = ("mass_modification", "predictor_corrector")
 INTEGRATORS = ("backward_euler", "generalized_alpha")

@@ -11,9 +11,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ballenv.physics import simulate
-from ballenv.physics.collision import find_contacts
-from ballenv.physics.model import build_collision_workspace, ground_array
+from ballenv.physics.build import build_collision_workspace
+from ballenv.physics.ground.motion import ground_array
 from ballenv.physics.simulation import SimulationError
+from ballenv.physics.walls.impulses import find_contacts
 
 GROUND_TOLERANCE = 1e-6  # m: deepest a node may be below a ground in an accepted state
 ENERGY_ROUND_OFF = 1e-9  # energy growth allowed, relative to the sum of |energy parts| at the start

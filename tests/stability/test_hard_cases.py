@@ -14,10 +14,10 @@ import numpy as np
 import pytest
 
 from ballenv.physics import Ground, Ring, Scene, SimulationError, simulate
-from ballenv.physics.integrator import build_solver
-from ballenv.physics.layout import REJECT_NEWTON
-from ballenv.physics.model import build_model, build_workspace, empty_state
-from ballenv.physics.stepper import initial_state_values, try_step
+from ballenv.physics.base.layout import REJECT_NEWTON
+from ballenv.physics.build import build_model, build_workspace, empty_state
+from ballenv.physics.step.integrator import build_solver
+from ballenv.physics.step.stepper import initial_state_values, try_step
 
 from .cases import CONTACTS, INTEGRATORS, hard_cases, released_flat
 from .invariants import audit
@@ -92,7 +92,7 @@ def test_a_failed_newton_iteration_is_rejected_and_leaves_the_state_untouched():
     scene, v0 = _violent_ring(dt=5e-3, newton_max_iter=1)
     model, solver, ws = build_model(scene), build_solver(scene), build_workspace(32)
     state, trial = empty_state(1, 32), empty_state(1, 32)
-    from ballenv.physics.simulation import initial_state
+    from ballenv.physics.build import initial_state
 
     state.x[:] = initial_state(scene)[0]
     state.v[:] = v0

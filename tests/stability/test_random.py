@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 
 from ballenv.envs.inflated_ball import InflatedBallEnv
 from ballenv.physics import Ground, Ring, Scene, simulate
-from ballenv.physics.ring import inflated_radius
+from ballenv.physics.base.ring import inflated_radius
 
 from .invariants import audit
 

@@ -3,8 +3,9 @@
 **The contract of a force effect** (a module; see :mod:`.gravity` for the smallest one). Module
 attributes:
 
-* ``NAME``: its name in ``Scene.effects``; ``enabled(scene) -> bool`` (Python): does the scene ask
-  for it. What a scene does not name costs one branch per force evaluation.
+* ``NAME``: its name in the list of effects a scene switches on (``build.scene_effects``);
+  ``enabled(scene) -> bool`` (Python): does the scene ask for it. What a scene does not name costs
+  one branch per force evaluation.
 * ``ENERGY_PART``: its column of the energy table (``"gravity"``), or None for a force without a
   potential (damping); ``LOW_RANK``: how many low-rank Jacobian columns it may append (at most).
 * ``PARAMETERS``: names of its own per-ring parameters (SI units), and ``parameters(scene, r) ->
@@ -12,8 +13,8 @@ attributes:
   per-ring record ``Model.effect_parameters[r]``; the effect sees them as ``p``. The built-in
   effects read named ``Model`` fields and declare none.
 
-and four numba kernels (``@kernel`` of :mod:`..jit`), for ring ``r`` with nodes ``x`` (N, 2) m and
-velocities ``v`` (N, 2) m/s:
+and four numba kernels (``@kernel`` of :mod:`ballenv.physics.base.jit`), for ring ``r`` with nodes ``x`` (N,
+2) m and velocities ``v`` (N, 2) m/s:
 
 * ``on(model, p, r) -> bool``: the effect acts on ring ``r`` (checked before every other kernel);
 * ``force(model, p, r, x, v, f)``: add its force (N) into ``f`` (N, 2);
@@ -23,44 +24,16 @@ velocities ``v`` (N, 2) m/s:
   ``+ u w^T``); return the new rank;
 * ``energy(model, p, r, x, v) -> float``: its potential (J), or 0.
 
-``EFFECTS`` lists them in the order their forces are summed; :mod:`..assembly` derives the ring's
-total force, Jacobian and energy parts from it when numba compiles. Adding a force is one new module
-here and one line in ``EFFECTS``; another list runs with ``Simulation(scene, effects=...)``.
+``EFFECTS`` lists them in the order their forces are summed; :mod:`ballenv.physics.effects.assembly` derives
+the ring's total force, Jacobian and energy parts from it when numba compiles. Adding a force is one new
+module here and one line in ``EFFECTS``; another list runs with ``Simulation(scene, effects=...)``.
 
-Ground contact (:mod:`..contact`: constrained rows and Coulomb friction in the Newton system) and
-ring collision (:mod:`..collision`: impulses between rings and within a ring) act through
-constraints and impulses in the step rather than as forces; ``CONSTRAINTS`` names them for
-``Scene.effects``.
+Ground contact (:mod:`ballenv.physics.ground.contact`: constrained rows and Coulomb friction in the
+Newton system) and ring collision (:mod:`ballenv.physics.walls.impulses`: impulses between rings and
+within a ring) act through constraints and impulses in the step rather than as forces;
+``build.CONSTRAINTS`` names them among a scene's effects (``build.scene_effects``).
 """
 
-from __future__ import annotations
-
-from collections.abc import Callable, Sequence
-from types import ModuleType
-from typing import TYPE_CHECKING, NamedTuple
-
-from .. import collision, contact
 from . import bending, damping, gas, gravity, stretching
 
-if TYPE_CHECKING:
-    from ..scene import Scene
-
 EFFECTS = (stretching, bending, gas, gravity, damping)
-
-
-class Constraint(NamedTuple):
-    name: str
-    enabled: Callable[[Scene], bool]
-
-
-CONSTRAINTS = (
-    Constraint("ground", contact.ground_enabled),
-    Constraint("friction", contact.friction_enabled),
-    Constraint("ring_collision", collision.enabled),
-)
-
-
-def scene_effects(scene: Scene, effects: Sequence[ModuleType] = EFFECTS) -> tuple[str, ...]:
-    """Names of the effects ``scene`` switches on, forces first, in registry order."""
-    names = [e.NAME for e in effects if e.enabled(scene)]
-    return tuple(names + [c.name for c in CONSTRAINTS if c.enabled(scene)])

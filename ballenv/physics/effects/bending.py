@@ -11,9 +11,9 @@ neighbours on each side (band half-width 2 nodes), exact. Always on.
 import math
 from typing import TYPE_CHECKING
 
-from ..cyclic import next_node, prev_node
-from ..jit import kernel
-from ..linalg import band_add_block
+from ..base.cyclic import next_node, prev_node
+from ..base.jit import kernel
+from ..base.linalg import band_add_block
 
 if TYPE_CHECKING:
     from ..scene import Scene

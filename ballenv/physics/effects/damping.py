@@ -9,9 +9,9 @@ On when ``Scene.damping`` is not 0.
 
 from typing import TYPE_CHECKING
 
-from ..geometry import rigid_motion
-from ..jit import kernel
-from ..linalg import band_add_block
+from ..base.geometry import rigid_motion
+from ..base.jit import kernel
+from ..base.linalg import band_add_block
 
 if TYPE_CHECKING:
     from ..scene import Scene

@@ -14,10 +14,10 @@ in O(N) by the Woodbury identity). On for rings with ``Ring.pressure`` set.
 import math
 from typing import TYPE_CHECKING
 
-from ..cyclic import next_node, prev_node
-from ..geometry import polygon_area
-from ..jit import kernel
-from ..linalg import band_add_block
+from ..base.cyclic import next_node, prev_node
+from ..base.geometry import polygon_area
+from ..base.jit import kernel
+from ..base.linalg import band_add_block
 
 if TYPE_CHECKING:
     from ..scene import Scene

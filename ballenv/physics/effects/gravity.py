@@ -6,7 +6,7 @@
 
 from typing import TYPE_CHECKING
 
-from ..jit import kernel
+from ..base.jit import kernel
 
 if TYPE_CHECKING:
     from ..scene import Scene

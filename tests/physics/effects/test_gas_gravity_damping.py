@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from ballenv.physics.base.geometry import polygon_area
 from ballenv.physics.effects.damping import (
     DAMPING_CENTRE_OF_MASS,
     DAMPING_RIGID,
@@ -17,7 +18,6 @@ from ballenv.physics.effects.gas import (
     pressure_jacobian,
 )
 from ballenv.physics.effects.gravity import gravity_energy, gravity_force
-from ballenv.physics.geometry import polygon_area
 
 from ..conftest import (
     DenseAssembler,

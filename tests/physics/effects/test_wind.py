@@ -9,7 +9,9 @@ import numpy as np
 import pytest
 
 from ballenv.physics import Ring, Scene, Simulation, simulate
-from ballenv.physics.assembly import (
+from ballenv.physics.build import build_model, build_workspace, scene_effects
+from ballenv.physics.effects import EFFECTS
+from ballenv.physics.effects.assembly import (
     effect_modules,
     energy_parts,
     field_name,
@@ -17,8 +19,6 @@ from ballenv.physics.assembly import (
     ring_force,
     ring_jacobian,
 )
-from ballenv.physics.effects import EFFECTS
-from ballenv.physics.model import build_model, build_workspace
 
 from ..conftest import (
     DenseAssembler,
@@ -53,7 +53,7 @@ def test_wind_is_registered_with_its_own_parameters_and_energy_part(blowing):
     assert energy_parts(WITH_WIND)[-1] == "wind"
     assert effect_modules(model.effect_parameters) == WITH_WIND
     np.testing.assert_array_equal(model.effect_parameters[field_name(len(EFFECTS), wind)], [[0.7, -0.2]])
-    assert "wind" not in _ring_scene().effects  # Scene.effects lists the registry's effects
+    assert "wind" not in scene_effects(_ring_scene())  # scene_effects lists the registry's effects
 
 
 def test_force_is_minus_energy_gradient_and_jacobian_is_exact(blowing):

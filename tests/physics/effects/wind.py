@@ -6,7 +6,7 @@ Every node of a ring gets the same force ``w`` (N), the ring's own parameters ``
 where this example takes its values from; a built-in force would read a Scene or Ring field.
 """
 
-from ballenv.physics.jit import kernel
+from ballenv.physics.base.jit import kernel
 
 NAME = "wind"
 ENERGY_PART = "wind"

@@ -1,0 +1,158 @@
+"""train.py end to end on a tiny budget, and the evaluation command's reproducibility."""
+
+import json
+import pathlib
+import subprocess
+import sys
+
+import pytest
+import yaml
+
+from agents.evaluate import evaluate, main
+from agents.train import main as train_main
+from agents.train import parse_args, train
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+SHORT = {"max_episode_steps": 60}  # gym.make's time limit: short episodes for the tests
+TINY = {
+    "ppo": {"n_steps": 64, "batch_size": 64, "n_epochs": 2},
+    "sac": {"learning_starts": 64, "batch_size": 64, "buffer_size": 1000},
+}
+
+
+@pytest.mark.parametrize("mode", ["pressure", "paddle"])
+@pytest.mark.parametrize("algo", ["ppo", "sac"])
+def test_train_runs_end_to_end_and_the_saved_agent_reloads(algo, mode, tmp_path):
+    command = [
+        sys.executable, str(ROOT / "train.py"), "--algo", algo, "--action-mode", mode, "--seed", "3",
+        "--n-envs", "2", "--total-timesteps", "256", "--eval-freq", "128", "--eval-episodes", "1",
+        "--final-episodes", "1", "--log-dir", str(tmp_path), "--env-kwargs", json.dumps(SHORT),
+        "--hyperparams", json.dumps(TINY[algo]),
+    ]  # fmt: skip
+    done = subprocess.run(command, cwd=ROOT, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr[-3000:]
+    run = tmp_path / f"{algo}_{mode}_seed3"
+    saved = ["model.zip", "vecnormalize.pkl", "best_model.zip", "best_vecnormalize.pkl", "config.yml"]
+    saved += ["command.txt", "evaluations.npz", "scores.md", "scores.json", "learning_curve.png"]
+    for name in saved:
+        assert (run / name).exists(), name
+    assert any((run / "checkpoints").iterdir())
+    assert any((run / "tensorboard").rglob("events.out.tfevents*"))
+    config = yaml.safe_load((run / "config.yml").read_text())
+    assert config["seed"] == 3 and config["algo"] == algo and config["env_kwargs"]["action_mode"] == mode
+    ids = {"pressure": "ballenv:InflatedBall-v3", "paddle": "ballenv:InflatedBallPaddle-v3"}
+    assert config["env_id"] == ids[mode]
+    assert "--total-timesteps 256" in (run / "command.txt").read_text()
+    scores = json.loads((run / "scores.json").read_text())
+    assert [s["policy"] for s in scores][1:] == ["heuristic", "random"]
+    # the saved model and its normalisation reload and evaluate, from the run folder alone
+    again = evaluate(str(run), config["env_kwargs"], episodes=1)
+    assert again.apex_error == pytest.approx(scores[0]["apex_error"])
+    assert again.episode_length == scores[0]["episode_length"]
+
+
+@pytest.mark.parametrize("policy", ["random", "heuristic"])
+def test_evaluation_gives_the_same_numbers_twice(policy):
+    kwargs = {**SHORT, "action_mode": "pressure", "max_episode_steps": 300}
+    first = evaluate(policy, kwargs, episodes=3, seed=123)
+    second = evaluate(policy, kwargs, episodes=3, seed=123)
+    assert first == second
+    other = evaluate(policy, kwargs, episodes=3, seed=124)
+    assert other != first
+
+
+def test_evaluate_command_line(tmp_path, capsys):
+    out = tmp_path / "score.json"
+    main(["heuristic", "--action-mode", "paddle", "--episodes", "2", "--env-kwargs", json.dumps(SHORT),
+          "--json", str(out)])  # fmt: skip
+    assert "| heuristic | 2 |" in capsys.readouterr().out
+    assert json.loads(out.read_text())["episodes"] == 2
+    with pytest.raises(SystemExit):
+        main(["heuristic", "--env-kwargs", "[1, 2]"])
+
+
+def test_a_hyperparameter_typo_is_one_readable_line_and_leaves_no_run_folder(tmp_path):
+    with pytest.raises(SystemExit) as stop:
+        train_main(["--hyperparams", '{"n_step": 64}', "--log-dir", str(tmp_path / "runs")])
+    message = str(stop.value.code)
+    assert message.startswith("ballenv-train: error: unknown PPO hyperparameter 'n_step'")
+    assert "did you mean 'n_steps'?" in message
+    assert not (tmp_path / "runs").exists()
+
+
+def test_a_conf_file_is_read_by_name_or_path_and_a_missing_one_is_named(tmp_path):
+    from agents.config import load_hyperparams
+
+    cloned = load_hyperparams("ppo", "paddle", "ppo_cloned")
+    assert cloned["env_wrapper"] == "agents.wrappers.PaddleStrike" and cloned["learning_rate"] == 3e-5
+    assert load_hyperparams("ppo", "pressure", "ppo_cloned")["env_wrapper"] == "agents.wrappers.PumpApex"
+    own = tmp_path / "mine.yml"
+    own.write_text("InflatedBall-v3:\n  n_timesteps: 64\n")
+    assert load_hyperparams("ppo", "pressure", str(own)) == {"n_timesteps": 64}
+    for conf, message in ((str(tmp_path / "none.yml"), "no such file"), (str(own), "no entry for")):
+        with pytest.raises(SystemExit) as stop:
+            train_main(["--action-mode", "paddle", "--conf-file", conf, "--log-dir", str(tmp_path / "runs")])
+        assert (
+            message in str(stop.value.code)
+            and "ppo_cloned" in str(stop.value.code)
+            or message == "no entry for"
+        )
+    assert not (tmp_path / "runs").exists()
+
+
+def test_a_mistyped_policy_names_the_choices(capsys):
+    choices = "must be one of \\('random', 'heuristic', 'lookahead'\\)"
+    with pytest.raises(ValueError, match="policy = 'heuristc' is invalid: " + choices):
+        evaluate("heuristc", {"max_episode_steps": 5}, episodes=1)
+    with pytest.raises(SystemExit):
+        main(["heuristc", "--episodes", "1"])
+    assert "policy = 'heuristc' is invalid" in capsys.readouterr().err
+
+
+def test_a_failed_setup_leaves_no_run_folder(tmp_path):
+    runs = tmp_path / "runs"
+    quick = ["--total-timesteps", "64", "--final-episodes", "0", "--log-dir", str(runs)]
+    # an env keyword the env refuses (the default pressure range bursts a 0.1 MPa wall)
+    with pytest.raises(ValueError, match=r"InflatedBall-v3\.pressure_range"):
+        train(parse_args(["--env-kwargs", '{"youngs_modulus": 1e5}', *quick]))
+    assert not runs.exists()
+    # PPO refusing its hyperparameters once the envs are open; an earlier run in runs/ stays
+    (runs / "ppo_pressure_seed0").mkdir(parents=True)
+    with pytest.raises(AssertionError, match="batch_size"):
+        train(parse_args(["--hyperparams", '{"n_steps": 1, "batch_size": 1}', *quick]))
+    assert [p.name for p in runs.iterdir()] == ["ppo_pressure_seed0"]
+
+
+def test_the_task_env_keywords_come_from_the_yaml_and_baselines_are_scored_on_them(monkeypatch):
+    import agents.config
+    import agents.evaluate
+
+    entry = {"env_kwargs": {"fidelity": "balanced", "reward_margin": 0.1}}
+    monkeypatch.setattr(agents.config, "load_hyperparams", lambda algo, mode: entry)
+    assert agents.config.task_env_kwargs("ppo", "paddle", {"reward_margin": 0.2}) == {
+        "fidelity": "balanced", "reward_margin": 0.2, "action_mode": "paddle",
+    }  # fmt: skip
+    seen = []
+
+    def record(policy, env_kwargs, *args, **kwargs):
+        seen.append(dict(env_kwargs))
+        raise SystemExit(0)
+
+    monkeypatch.setattr(agents.evaluate, "evaluate", record)
+    with pytest.raises(SystemExit):
+        main(["heuristic", "--action-mode", "paddle"])
+    assert seen == [{"fidelity": "balanced", "reward_margin": 0.1, "action_mode": "paddle"}]
+
+
+def test_rl_zoo_linear_schedules_are_read_and_a_malformed_one_is_named():
+    from agents.config import UsageError
+    from agents.train import schedules
+
+    out = schedules({"learning_rate": "lin_3e-4", "clip_range": 0.2, "gamma": 0.99})
+    assert out["learning_rate"](1.0) == pytest.approx(3e-4)
+    assert out["learning_rate"](0.25) == pytest.approx(7.5e-5)
+    assert out["clip_range"] == 0.2 and out["gamma"] == 0.99
+    with pytest.raises(UsageError, match="learning_rate = 'exp_3e-4'"):
+        schedules({"learning_rate": "exp_3e-4"})
+    with pytest.raises(UsageError, match="clip_range = 'lin_x'"):
+        schedules({"clip_range": "lin_x"})
