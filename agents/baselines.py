@@ -23,7 +23,10 @@ from numpy.typing import NDArray
 
 from .config import ALGORITHMS
 from .lookahead import lookahead_for
+from .normalization import Normalization
+from .normalization import load as load_normalization
 from .policies import HeuristicPolicy, Policy, RandomPolicy
+from .signatures import require_signed
 from .wrappers import wrapper_class
 
 NAMED_POLICIES = ("random", "heuristic", "lookahead")  # make_policy's policies by name
@@ -32,20 +35,26 @@ NAMED_POLICIES = ("random", "heuristic", "lookahead")  # make_policy's policies 
 class ModelPolicy:
     """A saved Stable-Baselines3 model (``model.zip`` of a run folder, or any path to a .zip).
 
-    The observation wrapper the run was trained behind (``env_wrapper`` in its ``config.yml``) and
-    the observation normalisation (``vecnormalize.pkl`` next to it, ``best_vecnormalize.pkl`` for
-    ``best_model.zip``) are applied, the latter frozen, if present; a wrapper that also acts
-    (``action`` and ``restart`` methods: ``agents.wrappers.ResidualPump``) turns the model's action
-    into the env's and is restarted at each episode start; one that plays the env itself (an ``act``
-    method: ``agents.wrappers.PumpAmplitude``) is given each env observation and asks the model
-    when it needs an action.
+    The model is loaded only if this user's training signed it, or with ``trust``
+    (:func:`agents.signatures.require_signed`: a saved model is a pickle, which runs code). The
+    observation wrapper the run was trained behind (``env_wrapper`` in its ``config.yml``) and the
+    observation normalisation (``vecnormalize.npz`` next to it, ``best_vecnormalize.npz`` for
+    ``best_model.zip``; :mod:`agents.normalization`) are applied, the latter frozen, if present; a
+    wrapper that also acts (``action`` and ``restart`` methods: ``agents.wrappers.ResidualPump``)
+    turns the model's action into the env's and is restarted at each episode start; one that plays
+    the env itself (an ``act`` method: ``agents.wrappers.PumpAmplitude``) is given each env
+    observation and asks the model when it needs an action.
     """
 
     name = "trained"
 
-    def __init__(self, env: gym.Env[Any, Any], path: str | os.PathLike[str], algo: str | None = None) -> None:
-        import pickle
-
+    def __init__(
+        self,
+        env: gym.Env[Any, Any],
+        path: str | os.PathLike[str],
+        algo: str | None = None,
+        trust: bool = False,
+    ) -> None:
         from stable_baselines3 import PPO, SAC
 
         path = pathlib.Path(path)
@@ -53,21 +62,12 @@ class ModelPolicy:
             path = path / ("best_model.zip" if (path / "best_model.zip").exists() else "model.zip")
         if not path.exists():
             raise ValueError(f"agents.evaluate: policy file {str(path)!r} does not exist")
+        require_signed(path, trust)  # a saved model is a pickle: only this user's runs, or --trust
         algo = algo or _algo_of(path)
         self.wrapper = _run_wrapper(path, env)
         classes: dict[str, type[PPO] | type[SAC]] = {"ppo": PPO, "sac": SAC}
-        cls = classes[algo]
-        self.model = cls.load(path, device="cpu")
-        self.normalize = None  # the saved VecNormalize (its env detached), frozen
-        stats = path.parent / (
-            "best_vecnormalize.pkl" if path.name == "best_model.zip" else "vecnormalize.pkl"
-        )
-        if stats.exists():
-            with open(stats, "rb") as f:
-                normalize = pickle.load(f)
-            if normalize.norm_obs:
-                normalize.training = False
-                self.normalize = normalize
+        self.model = classes[algo].load(path, device="cpu")
+        self.normalize = _normalization(path, trust)
 
     def reset(self, seed: int) -> None:
         restart = getattr(self.wrapper, "restart", None)
@@ -88,9 +88,29 @@ class ModelPolicy:
         """The model's deterministic action for a wrapped observation (normalised here, if the run
         normalised its observations)."""
         if self.normalize is not None:
-            obs = self.normalize.normalize_obs(obs).astype(np.float32)
+            obs = self.normalize.apply(obs)
         action, _ = self.model.predict(obs, deterministic=True)
         return np.asarray(action, dtype=np.float32).reshape(1)
+
+
+def _normalization(path: pathlib.Path, trust: bool) -> Normalization | None:
+    """The run's observation statistics for the model at ``path`` (plain data), or, from a run folder
+    of an older ballenv, its pickled ``VecNormalize`` (only with ``trust``); None if there are none."""
+    stem = "best_vecnormalize" if path.name == "best_model.zip" else "vecnormalize"
+    plain, pickled = path.parent / f"{stem}.npz", path.parent / f"{stem}.pkl"
+    if plain.exists():
+        return load_normalization(plain)
+    if not pickled.exists():
+        return None
+    require_signed(pickled, trust)
+    import pickle
+
+    with open(pickled, "rb") as f:
+        normalize = pickle.load(f)  # noqa: S301 - trusted by the user (--trust)
+    if not normalize.norm_obs:
+        return None
+    rms = normalize.obs_rms
+    return Normalization(np.asarray(rms.mean), np.asarray(rms.var), normalize.clip_obs, normalize.epsilon)
 
 
 def _run_wrapper(path: pathlib.Path, env: gym.Env[Any, Any]) -> gym.ObservationWrapper[Any, Any, Any] | None:
@@ -125,10 +145,11 @@ def make_policy(
     spec: str | os.PathLike[str] | Callable[[gym.Env[Any, Any]], Policy],
     env: gym.Env[Any, Any],
     algo: str | None = None,
+    trust: bool = False,
 ) -> Policy:
     """``"random"``, ``"heuristic"``, ``"lookahead"`` (the action mode's privileged reference,
-    :mod:`agents.lookahead`), a path to a saved model / run folder, or a callable ``env -> policy``
-    -> a policy."""
+    :mod:`agents.lookahead`), a path to a saved model / run folder (loaded only if this user's
+    training signed it, or with ``trust``), or a callable ``env -> policy`` -> a policy."""
     if callable(spec):
         return spec(env)
     if spec == "random":
@@ -143,4 +164,4 @@ def make_policy(
             f"agents.evaluate: policy = {str(spec)!r} is invalid: must be one of {NAMED_POLICIES}, a "
             "saved model (.zip) or a train.py run folder (no such file or folder)"
         )
-    return ModelPolicy(env, path, algo)
+    return ModelPolicy(env, path, algo, trust)

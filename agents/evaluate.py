@@ -37,6 +37,7 @@ import numpy as np
 
 from ballenv.envs.config import BallEnvConfig
 from ballenv.envs.inflated_ball import ball_env
+from ballenv.files import write_text
 
 from .baselines import NAMED_POLICIES, make_policy
 from .config import ENV_ID, SUCCESS_TOLERANCE, parse_env_kwargs, task_env_kwargs
@@ -99,12 +100,14 @@ def evaluate(
     seed: int = DEFAULT_SEED,
     algo: str | None = None,
     progress: bool = False,
+    trust: bool = False,
 ) -> Score:
     """Score ``policy`` (one of ``NAMED_POLICIES``, a saved model / run folder, or a callable ``env ->
     policy``) over ``episodes`` episodes of ``gym.make(ENV_ID, **env_kwargs)`` seeded ``seed, seed +
-    1, ...``."""
+    1, ...``. A saved model is loaded only if this user's training signed it, or with ``trust``
+    (:mod:`agents.signatures`)."""
     env = gym.make(ENV_ID, **(env_kwargs or {}))
-    agent = make_policy(policy, env, algo)
+    agent = make_policy(policy, env, algo, trust)
     per_episode, hits, apexes, lengths, returns = [], [], [], [], []
     seeds: Iterable[int] = range(seed, seed + episodes)
     if progress:
@@ -163,6 +166,11 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--seed", type=int, default=DEFAULT_SEED, help="seed of the first episode")
     parser.add_argument("--algo", choices=("ppo", "sac"), help="algorithm of a bare model .zip")
     parser.add_argument("--json", help="also write the score to this file")
+    parser.add_argument(
+        "--trust", action="store_true",
+        help="load a run folder or model this user's training did not write (a saved model is a "
+        "pickle: it runs the code it carries; use only for files from a source you trust)",
+    )  # fmt: skip
     return parser
 
 
@@ -177,13 +185,14 @@ def main(argv: Sequence[str] | None = None) -> None:
     if args.action_mode:
         env_kwargs["action_mode"] = args.action_mode
     try:
-        score = evaluate(args.policy, env_kwargs, args.episodes, args.seed, args.algo, progress=True)
+        score = evaluate(
+            args.policy, env_kwargs, args.episodes, args.seed, args.algo, progress=True, trust=args.trust
+        )
     except ValueError as err:  # a policy or env keyword the user mistyped
         parser.error(str(err))
     print(table([score]))
     if args.json:
-        with open(args.json, "w") as f:
-            json.dump(asdict(score), f, indent=2)
+        write_text(args.json, json.dumps(asdict(score), indent=2))
 
 
 def _run_env_kwargs(policy: str) -> dict[str, Any]:

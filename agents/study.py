@@ -42,6 +42,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ballenv.files import write_text
+
+from . import checkpoints
 from .config import parse_env_kwargs, task_env_kwargs
 from .evaluate import Score, evaluate
 from .train import ROOT, add_cluster_argument, compile_once, parse_args, train
@@ -165,10 +168,18 @@ def run_seed(job: SeedJob) -> SeedResult:
 
 
 def train_seed(job: SeedJob) -> pathlib.Path:
-    """The run folder of ``job``'s seed, trained now unless it holds scores already."""
+    """The run folder of ``job``'s seed, trained now unless it holds scores already: a run that was
+    interrupted goes on from its resumable state (``train.py --resume``); one that stopped before
+    saving any is moved aside (``.incomplete``) and trained again under its own name."""
     run = job.out / f"{job.algo}_{job.action_mode}_seed{job.seed}"
     if (run / "scores.json").exists():
         return run
+    if (run / checkpoints.RESUME / "state.json").exists():
+        return train(
+            parse_args(["--resume", str(run), "--no-baselines", "--final-episodes", str(job.episodes)])
+        )
+    if run.exists():
+        run.rename(run.with_name(run.name + ".incomplete"))
     argv = [
         "--algo", job.algo, "--action-mode", job.action_mode, "--vec-env", "subproc",
         "--seed", str(job.seed), "--log-dir", str(job.out), "--no-baselines",
@@ -189,7 +200,7 @@ def heldout_score(job: SeedJob, run: pathlib.Path) -> Score:
     if not path.exists():
         score = evaluate(run, job.env_kwargs, job.episodes, algo=job.algo, progress=True)
         score = Score(**{**asdict(score), "policy": stored.policy})
-        path.write_text(json.dumps(asdict(score), indent=2))
+        write_text(path, json.dumps(asdict(score), indent=2))
     return Score(**json.loads(path.read_text()))
 
 
@@ -273,8 +284,8 @@ def main(argv: Sequence[str] | None = None) -> None:
     rows = [summarise(f"{args.algo} (best model)", trained), *baselines]
     name = args.out / f"{args.algo}_{args.action_mode}"
     text = table(rows)
-    name.with_suffix(".md").write_text(text + "\n")
-    name.with_suffix(".json").write_text(json.dumps(rows, indent=2))
+    write_text(name.with_suffix(".md"), text + "\n")
+    write_text(name.with_suffix(".json"), json.dumps(rows, indent=2))
     plot(name.with_suffix(".png"), runs, baselines, f"{args.algo}, {args.action_mode} mode")
     print(text)
     print(f"wrote {name}.md, {name}.json and {name}.png")

@@ -15,9 +15,10 @@ model may be the clone itself. A run writes one folder ``{log_dir}/{algo}_{mode}
 
 * ``config.yml`` (algorithm, hyperparameters, env keyword arguments, seed, versions) and
   ``command.txt`` (the exact command);
-* ``model.zip`` and ``vecnormalize.pkl`` (final), ``best_model.zip`` and ``best_vecnormalize.pkl``
-  (best periodic evaluation), ``checkpoints/``, ``evaluations.npz``, Monitor logs and TensorBoard
-  logs (``tensorboard --logdir runs``);
+* ``model.zip`` and ``vecnormalize.npz`` (final), ``best_model.zip`` and ``best_vecnormalize.npz``
+  (best periodic evaluation), ``signatures.json`` (their HMACs under this user's key, so that
+  evaluation loads them without ``--trust``: ``agents.signatures``), ``checkpoints/``,
+  ``evaluations.npz``, Monitor logs and TensorBoard logs (``tensorboard --logdir runs``);
 * ``scores.md`` / ``scores.json``: the best model, the heuristic and random actions scored by
   ``agents.evaluate`` on the same held-out seeds, and ``learning_curve.png``.
 """
@@ -48,9 +49,14 @@ if TYPE_CHECKING:
     from stable_baselines3.common.vec_env import VecEnv
 
 
+from ballenv.files import write_text
+
+from . import checkpoints
 from .config import UsageError, env_id, load_hyperparams, parse_env_kwargs, task_env_kwargs
 from .evaluate import Score, evaluate, table
 from .imitation import TASKS, WRAPPERS, Demonstrations, pretrain
+from .normalization import save as save_normalization
+from .signatures import sign
 from .wrappers import wrapper_class
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent  # holds agents/: on a Ray worker's PYTHONPATH
@@ -92,6 +98,14 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
         "before learning; PPO behind the bounce-level task they were recorded in",
     )  # fmt: skip
     p.add_argument("--no-baselines", action="store_true", help="score only the trained agent at the end")
+    p.add_argument(
+        "--checkpoint-minutes", type=float, default=10.0,
+        help="save the resumable state (RUN/resume) every this many minutes (default 10; 0: only on Ctrl-C)",
+    )  # fmt: skip
+    p.add_argument(
+        "--resume", default=None, metavar="RUN",
+        help="go on with the run folder RUN from its resumable state, with its own settings",
+    )  # fmt: skip
     return p.parse_args(argv)
 
 
@@ -127,12 +141,15 @@ def run_folder(log_dir: str | os.PathLike[str], algo: str, mode: str, seed: int)
 
 
 @contextlib.contextmanager
-def removed_on_failure(run: pathlib.Path, made_log_dir: bool) -> Iterator[pathlib.Path]:
+def removed_on_failure(run: pathlib.Path, made_log_dir: bool, keep: bool = False) -> Iterator[pathlib.Path]:
     """Remove the run folder ``run`` if the block raises (and its parent, the log folder, if
-    ``made_log_dir`` and it is left empty): a setup that fails leaves no half-made run behind."""
+    ``made_log_dir`` and it is left empty): a setup that fails leaves no half-made run behind. A run
+    being resumed (``keep``) is never removed."""
     try:
         yield run
     except BaseException:
+        if keep:
+            raise
         shutil.rmtree(run, ignore_errors=True)
         if made_log_dir:
             with contextlib.suppress(OSError):  # not empty: another run is there
@@ -192,22 +209,33 @@ def callbacks(
     from stable_baselines3.common.callbacks import BaseCallback, CheckpointCallback, EvalCallback
 
     class Evaluation(EvalCallback):
-        """Stable-Baselines3's periodic evaluation, also before the first update if ``at_start``."""
+        """Stable-Baselines3's periodic evaluation, also before the first update if ``at_start``;
+        a resumed run goes on from the evaluations and the best model it had."""
 
         at_start = evaluate_at_start
 
         def _on_training_start(self) -> None:
             super()._on_training_start()
+            earlier = run / "evaluations.npz"
+            if args.resume and earlier.exists():
+                with np.load(earlier) as old:
+                    self.evaluations_timesteps = [int(s) for s in old["timesteps"]]
+                    self.evaluations_results = [list(r) for r in old["results"]]
+                    self.evaluations_length = [list(n) for n in old["ep_lengths"]]
+                means = [float(np.mean(r)) for r in self.evaluations_results]
+                self.best_mean_reward = max(means, default=-np.inf)
             if self.at_start:  # n_calls is 0, a multiple of eval_freq: _on_step evaluates
                 self._on_step()
 
     class SaveNormalization(BaseCallback):
-        """Save the VecNormalize statistics with each new best model."""
+        """Save the VecNormalize statistics with each new best model, and sign both."""
 
         def _on_step(self) -> bool:
             env = self.model.get_vec_normalize_env()
+            written = [run / "best_model.zip"]
             if env is not None:
-                env.save(str(run / "best_vecnormalize.pkl"))
+                written.append(save_normalization(env, run / "best_vecnormalize.npz"))
+            sign(written)
             return True
 
     class ProgressBar(BaseCallback):
@@ -326,6 +354,8 @@ def main(argv: Sequence[str] | None = None) -> None:
         train(parse_args(argv))
     except UsageError as err:
         sys.exit(f"ballenv-train: error: {err}")
+    except KeyboardInterrupt:
+        sys.exit(130)  # the resumable state is saved (train said where)
 
 
 def train(args: argparse.Namespace, on_evaluation: OnEvaluation | None = None) -> pathlib.Path:
@@ -338,8 +368,11 @@ def train(args: argparse.Namespace, on_evaluation: OnEvaluation | None = None) -
     from stable_baselines3 import PPO, SAC
     from stable_baselines3.common.vec_env import VecNormalize
 
-    hp = load_hyperparams(args.algo, args.action_mode, args.conf_file)
-    hp.update(args.hyperparams or {})
+    if args.resume:
+        args, hp = resumed(args)
+    else:
+        hp = load_hyperparams(args.algo, args.action_mode, args.conf_file)
+        hp.update(args.hyperparams or {})
     env_kwargs = task_env_kwargs(args.algo, args.action_mode, args.env_kwargs, entry=hp)
     n_envs = args.n_envs or int(hp.get("n_envs", 1))
     total = args.total_timesteps or int(hp["n_timesteps"])
@@ -358,7 +391,12 @@ def train(args: argparse.Namespace, on_evaluation: OnEvaluation | None = None) -
     demonstrations = load_demonstrations(args, wrapper)
 
     made_log_dir = not pathlib.Path(args.log_dir).exists()
-    run = run_folder(args.log_dir, args.algo, args.action_mode, args.seed)
+    run = (
+        pathlib.Path(args.resume)
+        if args.resume
+        else run_folder(args.log_dir, args.algo, args.action_mode, args.seed)
+    )
+    done = checkpoints.steps_done(run) if args.resume else 0
     config = {
         "algo": args.algo, "env_id": env_id(args.action_mode), "env_kwargs": env_kwargs, "seed": args.seed,
         "total_timesteps": total, "n_envs": n_envs, "normalize": normalize,
@@ -368,9 +406,13 @@ def train(args: argparse.Namespace, on_evaluation: OnEvaluation | None = None) -
         "versions": {"stable_baselines3": str(stable_baselines3.__version__),
                      "torch": str(torch.__version__)},
     }  # fmt: skip
-    with removed_on_failure(run, made_log_dir), contextlib.ExitStack() as opened:
-        (run / "config.yml").write_text(yaml.safe_dump(config, sort_keys=False))
-        (run / "command.txt").write_text(shlex.join([sys.executable, *sys.argv]) + "\n")
+    with removed_on_failure(run, made_log_dir, keep=bool(args.resume)), contextlib.ExitStack() as opened:
+        command = shlex.join([sys.executable, *sys.argv]) + "\n"
+        if args.resume:
+            command = (run / "command.txt").read_text() + command
+        else:
+            write_text(run / "config.yml", yaml.safe_dump(config, sort_keys=False))
+        write_text(run / "command.txt", command)
         torch.set_num_threads(1)
         envs = make_envs(
             env_kwargs, n_envs, args.seed, normalize, gamma, run / "monitor",
@@ -381,10 +423,13 @@ def train(args: argparse.Namespace, on_evaluation: OnEvaluation | None = None) -
             env_kwargs, 1, args.seed + 1000, normalize, gamma, training=False, wrapper=wrapper
         )
         opened.callback(eval_env.close)
-        model = cls(
-            config["policy"], envs, seed=args.seed, tensorboard_log=str(run / "tensorboard"), device="cpu",
-            verbose=0, **model_kwargs,
-        )  # fmt: skip
+        if args.resume:
+            model = checkpoints.load(run, cls, envs)
+        else:
+            model = cls(
+                config["policy"], envs, seed=args.seed, tensorboard_log=str(run / "tensorboard"),
+                device="cpu", verbose=0, **model_kwargs,
+            )  # fmt: skip
         opened.pop_all()  # set up: the envs stay open for the training
     if demonstrations is not None:
         fit = pretrain(model, envs, demonstrations)
@@ -393,11 +438,17 @@ def train(args: argparse.Namespace, on_evaluation: OnEvaluation | None = None) -
               f"squared error of the action {action:.2e}, of the value {value:.2e}")  # fmt: skip
     start = time.perf_counter()
     steps = callbacks(run, eval_env, args, n_envs, total, on_evaluation, demonstrations is not None)
-    model.learn(total_timesteps=total, callback=steps)
+    with checkpoints.CtrlC() as ctrl_c:
+        steps += [checkpoints.every(run, args.checkpoint_minutes), ctrl_c.callback()]
+        model.learn(total_timesteps=total - done, callback=steps, reset_num_timesteps=not args.resume)
+    if ctrl_c.requested:
+        interrupted(run, model, envs, eval_env)
     wall = time.perf_counter() - start
     model.save(run / "model")
+    written = [run / "model.zip"]
     if isinstance(envs, VecNormalize):  # normalize
-        envs.save(str(run / "vecnormalize.pkl"))
+        written.append(save_normalization(envs, run / "vecnormalize.npz"))
+    sign(written)  # this user's training wrote them (agents.signatures): evaluation loads them
     envs.close()
     eval_env.close()
     print(f"trained {args.algo} for {model.num_timesteps} env steps in {wall:.0f} s "
@@ -405,6 +456,43 @@ def train(args: argparse.Namespace, on_evaluation: OnEvaluation | None = None) -
     if args.final_episodes > 0:
         score(run, args, env_kwargs, wall, model.num_timesteps)
     return run
+
+
+def interrupted(run: pathlib.Path, model: BaseAlgorithm, envs: VecEnv, eval_env: VecEnv) -> None:
+    """Save the resumable state of a training stopped by Ctrl-C, say how to go on, and raise
+    KeyboardInterrupt."""
+    folder = checkpoints.save(run, model, envs)
+    envs.close()
+    eval_env.close()
+    print(f"\ninterrupted at {model.num_timesteps} env steps; the state is saved in {folder}: go on "
+          f"with  python train.py --resume {run}", file=sys.stderr)  # fmt: skip
+    raise KeyboardInterrupt
+
+
+def resumed(args: argparse.Namespace) -> tuple[argparse.Namespace, dict[str, Any]]:
+    """The arguments and hyperparameters of the run folder ``args.resume``, as it was started
+    (``config.yml``); what the command line says of the run itself is ignored."""
+    config_path = pathlib.Path(args.resume) / "config.yml"
+    if not config_path.exists():
+        raise UsageError(f"--resume {args.resume}: no config.yml there (not a run folder of train.py)")
+    try:
+        checkpoints.steps_done(pathlib.Path(args.resume))
+    except ValueError as err:  # no resumable state, or one this user's training did not sign
+        raise UsageError(f"--resume {args.resume}: {err}") from None
+    config = yaml.safe_load(config_path.read_text())
+    hp = {
+        **config["hyperparams"], "policy": config["policy"], "normalize": config["normalize"],
+        "env_wrapper": config["env_wrapper"], "n_envs": config["n_envs"],
+        "n_timesteps": config["total_timesteps"], "env_kwargs": config["env_kwargs"],
+    }  # fmt: skip
+    new = argparse.Namespace(**{
+        **vars(args), "algo": config["algo"], "action_mode": config["env_kwargs"]["action_mode"],
+        "env_kwargs": config["env_kwargs"], "seed": config["seed"], "n_envs": config["n_envs"],
+        "total_timesteps": config["total_timesteps"], "eval_freq": config["eval_freq"],
+        "eval_episodes": config["eval_episodes"], "vec_env": config["vec_env"],
+        "demonstrations": None, "conf_file": None, "hyperparams": None,
+    })  # fmt: skip
+    return new, hp
 
 
 def score(
@@ -419,8 +507,8 @@ def score(
     text = table(scores)
     print(text)
     header = f"{args.algo}, {args.action_mode} mode, {steps} env steps in {wall:.0f} s, seed {args.seed}\n\n"
-    (run / "scores.md").write_text(header + text + "\n")
-    (run / "scores.json").write_text(json.dumps([asdict(s) for s in scores], indent=2))
+    write_text(run / "scores.md", header + text + "\n")
+    write_text(run / "scores.json", json.dumps([asdict(s) for s in scores], indent=2))
     plot_learning_curve(run, scores)
     print(f"wrote {run / 'scores.md'} and {run / 'learning_curve.png'}")
 

@@ -44,6 +44,8 @@ import yaml
 if TYPE_CHECKING:
     import optuna
 
+from ballenv.files import write_text
+
 from .config import HEURISTIC_PARAMS, heuristic_table, load_hyperparams, task_env_kwargs
 from .evaluate import evaluate
 from .policies import HeuristicPolicy
@@ -142,7 +144,7 @@ def tune_heuristic(args: argparse.Namespace) -> optuna.Study:
             "# TPE, mean apex error over training seeds), one entry per env id; read by\n"
             "# agents.policies.HeuristicPolicy.\n"
         )
-        HEURISTIC_PARAMS.write_text(header + yaml.safe_dump(table, sort_keys=True))
+        write_text(HEURISTIC_PARAMS, header + yaml.safe_dump(table, sort_keys=True))
         print(f"wrote {HEURISTIC_PARAMS}")
     return study
 
@@ -233,9 +235,9 @@ def tune_ppo(args: argparse.Namespace) -> optuna.Study:
         value = "" if t.value is None else f"{t.value:.1f}"
         lines.append(f"| {t.number} | {t.state.name.lower()} | {value} | {t.params} |")
     name = args.out / f"ppo_{args.action_mode}"
-    name.with_suffix(".md").write_text("\n".join(lines) + "\n")
+    write_text(name.with_suffix(".md"), "\n".join(lines) + "\n")
     best = {ENV_IDS[args.action_mode]: sample_ppo(optuna.trial.FixedTrial(study.best_params))}
-    name.with_suffix(".yml").write_text(yaml.safe_dump(best, sort_keys=False))
+    write_text(name.with_suffix(".yml"), yaml.safe_dump(best, sort_keys=False))
     print("\n".join(lines))
     print(f"best return {study.best_value:.1f}; wrote {name}.md and {name}.yml")
     return study

@@ -15,8 +15,9 @@ What a task returns does not depend on where it runs: the same items give the sa
 serial run (a simulation is deterministic and each task gets its item whole). Ray retries a task
 whose worker died (the process killed, the node lost) up to ``max_retries`` times; a task whose
 every attempt died is yielded as :class:`TaskLost` and the sweep goes on, so the results of every
-other task are kept. Each index is yielded exactly once, whether its task was retried or not. An
-exception that ``fn`` raises is re-raised, as in the serial run.
+other task are kept; a task whose ``fn`` raised on the cluster is yielded as :class:`TaskFailed`
+(with the exception's type and message) beside the others. Each index is yielded exactly once,
+whether its task was retried or not. In the serial run an exception of ``fn`` is raised at once.
 
 numba compiles the simulator's kernels on first use (a minute or more) and caches them on disk, in the
 package's ``__pycache__`` folders (or ``NUMBA_CACHE_DIR``), which every worker of a node shares.
@@ -44,6 +45,14 @@ RETRIES = 3  # Ray's default for tasks: attempts after the first when a worker d
 @dataclasses.dataclass(frozen=True)
 class TaskLost:
     """The outcome of a task whose every attempt died with its worker (``reason``: Ray's error)."""
+
+    index: int
+    reason: str
+
+
+@dataclasses.dataclass(frozen=True)
+class TaskFailed:
+    """The outcome of a task whose ``fn`` raised on the cluster (``reason``: the exception)."""
 
     index: int
     reason: str
@@ -159,6 +168,9 @@ def _on_ray(fn, items, bar, max_retries) -> Iterator[tuple[int, Any]]:
             ray.exceptions.NodeDiedError,
         ) as died:
             result = TaskLost(index, f"{type(died).__name__}: {str(died).splitlines()[0]}")
+        except ray.exceptions.RayTaskError as raised:  # fn raised: kept beside the other results
+            cause = raised.cause if raised.cause is not None else raised
+            result = TaskFailed(index, f"{type(cause).__name__}: {str(cause).splitlines()[-1]}")
         bar.update()
         yield index, result
 
@@ -199,17 +211,17 @@ def run_tasks(
                 _ray().shutdown()
 
 
-def collect(outcomes: Iterator[tuple[int, Any]], count: int) -> tuple[list[Any], list[TaskLost]]:
-    """The results of :func:`run_tasks` in item order (``None`` where a task was lost) and the lost
-    tasks; a ValueError if an index came twice or not at all."""
+def collect(outcomes: Iterator[tuple[int, Any]], count: int) -> tuple[list[Any], list[TaskLost | TaskFailed]]:
+    """The results of :func:`run_tasks` in item order (``None`` where a task was lost or failed) and
+    the lost and failed tasks; a ValueError if an index came twice or not at all."""
     results: list[Any] = [None] * count
     seen = [False] * count
-    lost = []
+    lost: list[TaskLost | TaskFailed] = []
     for index, result in outcomes:
         if seen[index]:
             raise ValueError(f"task {index} gave two results")
         seen[index] = True
-        if isinstance(result, TaskLost):
+        if isinstance(result, TaskLost | TaskFailed):
             lost.append(result)
         else:
             results[index] = result

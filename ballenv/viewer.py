@@ -21,11 +21,13 @@ import html
 import json
 import math
 import pathlib
+import re
 import sys
 
 import numpy as np
 
 from .draw import STYLE
+from .files import write_text
 from .physics.trajectory import Trajectory
 
 
@@ -196,11 +198,23 @@ def write_html(traj, path, max_frames=2000, title=None):
     if not isinstance(max_frames, int) or max_frames < 2:
         raise ValueError(f"write_html.max_frames = {max_frames!r} is out of range: must be an integer >= 2")
     data = viewer_data(traj, max_frames, title)
-    payload = json.dumps(data).replace("</", "<\\/")
-    page = PAGE.replace("__TITLE__", html.escape(data["title"])).replace("__DATA__", payload)
-    path = pathlib.Path(path)
-    path.write_text(page, encoding="utf-8")
-    return path
+    return write_text(path, page(data))
+
+
+# JSON inside <script type="application/json">: the characters that could end the element, open a
+# comment or a new tag, or start an entity are escaped (JSON reads them back unchanged)
+SCRIPT_ESCAPES = {ord("<"): "\\u003c", ord(">"): "\\u003e", ord("&"): "\\u0026"}
+
+
+def page(data):
+    """The HTML page of ``data`` (:func:`viewer_data`): the title HTML-escaped, the data as JSON with
+    ``<``, ``>`` and ``&`` escaped, both put in one pass over the template (a placeholder inside the
+    title or the data is text, never a place to fill)."""
+    fills = {
+        "__TITLE__": html.escape(str(data["title"])),
+        "__DATA__": json.dumps(data).translate(SCRIPT_ESCAPES),
+    }
+    return re.sub("__TITLE__|__DATA__", lambda m: fills[m.group(0)], PAGE)
 
 
 def main(argv=None):

@@ -32,6 +32,7 @@ import time  # noqa: E402
 
 from ball_family import BALLS, ball_scene, first_apex, gas_to_bending, reference_apex  # noqa: E402
 
+from ballenv.files import write_text  # noqa: E402
 from ballenv.physics import Ground, SimulationError, simulate  # noqa: E402
 from ballenv.physics.build import initial_state  # noqa: E402
 from ballenv.physics.presets import FIDELITY_PRESETS, with_fidelity  # noqa: E402
@@ -63,7 +64,7 @@ def references(recompute=False):
             fine, uncertainty = reference_apex(name, n_nodes=n_nodes)
             by_ball[name] = {"apex": fine, "uncertainty": uncertainty}
             print(f"reference {name}, N = {n_nodes}: {fine:.6f} m (+- {uncertainty:.1e})", flush=True)
-    REFERENCES.write_text(json.dumps(refs, indent=1) + "\n")
+    write_text(REFERENCES, json.dumps(refs, indent=1) + "\n")
     return refs
 
 
@@ -283,7 +284,7 @@ def main(argv=None):
     text = report(refs, runs, tolerances)
     print(text)
     if not args.quick:
-        (RESULTS / "accuracy.md").write_text(text)
+        write_text(RESULTS / "accuracy.md", text)
         plot(runs, tolerances, RESULTS / "accuracy.png")
 
 

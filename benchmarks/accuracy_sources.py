@@ -22,6 +22,7 @@ import numpy as np  # noqa: E402
 from accuracy import NUMERICS, TOLERANCES, references  # noqa: E402
 from ball_family import BALLS, T_END, ball_scene, first_apex, reference_scene  # noqa: E402
 
+from ballenv.files import write_text  # noqa: E402
 from ballenv.physics import simulate  # noqa: E402
 
 RESULTS = pathlib.Path(__file__).parent / "results"
@@ -82,7 +83,7 @@ def table(refs, progress=print):
 def main():
     refs = references()
     text = "\n".join(["# Where the error and the cost of `rtol` come from", "", *table(refs)]) + "\n"
-    (RESULTS / "accuracy_sources.md").write_text(text)
+    write_text(RESULTS / "accuracy_sources.md", text)
     print(text)
 
 

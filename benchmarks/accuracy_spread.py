@@ -23,10 +23,12 @@ import dataclasses  # noqa: E402
 import pathlib  # noqa: E402
 import time  # noqa: E402
 
-import numpy as np  # noqa: E402
+import numpy as np
 from accuracy import CONTROLS, NUMERICS, SWEEP_NODES, TOLERANCES, falls_at_every_tightening  # noqa: E402
 from ball_family import BALLS, ball_scene, first_apex, reference_scene  # noqa: E402
 from scipy.interpolate import CubicHermiteSpline  # noqa: E402
+
+from ballenv.files import write_text  # noqa: E402
 
 RESULTS = pathlib.Path(__file__).parent / "results"
 HEIGHT_FACTORS = (0.94, 0.97, 1.0, 1.03, 1.06)  # the drops' start heights over the ball's own
@@ -150,7 +152,7 @@ def main():
     results = spread()
     text = report(results, time.perf_counter() - start)
     print(text)
-    (RESULTS / "accuracy_spread.md").write_text(text)
+    write_text(RESULTS / "accuracy_spread.md", text)
 
 
 if __name__ == "__main__":

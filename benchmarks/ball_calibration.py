@@ -30,6 +30,7 @@ sys.path.insert(0, str(ROOT))
 from scipy.optimize import brentq  # noqa: E402
 
 from ballenv.balls import BALLS, Ball, drop  # noqa: E402
+from ballenv.files import write_text  # noqa: E402
 from ballenv.physics.base.ring import bending_stiffness  # noqa: E402
 
 RESULTS = ROOT / "benchmarks" / "results"
@@ -243,7 +244,7 @@ def main(argv=None):
     rows = rows_of(balls)
     sweep = pressure_sweep(balls)
     RESULTS.mkdir(exist_ok=True)
-    (RESULTS / "ball_calibration.md").write_text(markdown(rows, sweep))
+    write_text(RESULTS / "ball_calibration.md", markdown(rows, sweep))
     plot(sweep, balls, RESULTS / "ball_calibration.png")
     return 0
 

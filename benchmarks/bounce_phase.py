@@ -25,6 +25,7 @@ import numpy as np  # noqa: E402
 
 from ballenv.envs.config import BallEnvConfig  # noqa: E402
 from ballenv.envs.numerics import ENV_FIDELITIES  # noqa: E402
+from ballenv.files import write_text  # noqa: E402
 from ballenv.physics import simulate  # noqa: E402
 from ballenv.physics.base.ring import initial_nodes  # noqa: E402
 
@@ -78,7 +79,7 @@ def main() -> None:
         + "\n"
     )
     RESULTS.mkdir(exist_ok=True)
-    (RESULTS / "bounce_phase.md").write_text(text)
+    write_text(RESULTS / "bounce_phase.md", text)
     print(f"wrote {RESULTS / 'bounce_phase.md'}")
 
 

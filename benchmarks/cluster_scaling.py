@@ -24,6 +24,7 @@ sys.path.insert(0, str(ROOT))
 import ray  # noqa: E402
 
 from ballenv.cluster import collect, connect, run_tasks, warm_simulator  # noqa: E402
+from ballenv.files import write_text  # noqa: E402
 from tests.stability.invariants import audit  # noqa: E402
 
 sys.path.insert(0, str(ROOT / "benchmarks"))
@@ -143,7 +144,7 @@ def main():
     cold = {warm: cold_start(tasks[: args.cold_scenes], warm) for warm in (True, False)}
     text = report(args, runs, cold)
     print(text)
-    (RESULTS / "cluster_scaling.md").write_text(text)
+    write_text(RESULTS / "cluster_scaling.md", text)
 
 
 if __name__ == "__main__":

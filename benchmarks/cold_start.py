@@ -21,6 +21,8 @@ import sys
 import tempfile
 import time
 
+from ballenv.files import write_text
+
 RESULTS = pathlib.Path(__file__).parent / "results"
 
 FIRST_STEPS = """
@@ -44,6 +46,7 @@ if __name__ == "__main__":
 FIRST_SIMULATE = """
 import sys
 from ballenv.physics import Ground, Ring, Scene, simulate
+from ballenv.files import write_text  # noqa: E402
 
 n = int(sys.argv[1])
 rings = [Ring(radius=0.1, n_nodes=32, pressure=30e3, position=(0.25 * k, 0.3)) for k in range(n)]
@@ -94,7 +97,7 @@ def main():
     ]
     text = "\n".join(lines)
     print(text)
-    (RESULTS / "cold_start.md").write_text(text)
+    write_text(RESULTS / "cold_start.md", text)
 
 
 if __name__ == "__main__":

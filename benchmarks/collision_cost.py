@@ -20,6 +20,7 @@ import time  # noqa: E402
 import numpy as np  # noqa: E402
 from tqdm.auto import tqdm  # noqa: E402
 
+from ballenv.files import write_text  # noqa: E402
 from ballenv.physics.build import build_collision_workspace  # noqa: E402
 from ballenv.physics.walls.impulses import CONTACT_COLUMNS, find_contacts, find_contacts_all_pairs  # noqa: E402
 
@@ -92,7 +93,7 @@ def main():
         )
     text = "\n".join(lines) + "\n"
     RESULTS.mkdir(exist_ok=True)
-    (RESULTS / "collision_cost.md").write_text(text)
+    write_text(RESULTS / "collision_cost.md", text)
     print(text)
     _plot(rows)
 

@@ -18,6 +18,7 @@ import pathlib  # noqa: E402
 import numpy as np  # noqa: E402
 from tqdm.auto import tqdm  # noqa: E402
 
+from ballenv.files import write_text  # noqa: E402
 from ballenv.physics import Ground, Ring, Scene, simulate  # noqa: E402
 
 RESULTS = pathlib.Path(__file__).parent / "results"
@@ -105,7 +106,7 @@ def main():
         ok = "yes" if (err <= 0.01 and wall <= 0.05) else "no"
         lines.append(f"| {name} | {steps} | {rejected} | {newton} | {wall * 1e3:.1f} | {err:.1e} | {ok} |")
     text = "\n".join(lines) + "\n"
-    (RESULTS / "contact_cost.md").write_text(text)
+    write_text(RESULTS / "contact_cost.md", text)
     print(text)
     _plot(curves, RESULTS / "contact_cost.png")
 

@@ -35,6 +35,7 @@ from step_cost import compile_times  # noqa: E402
 import ballenv  # noqa: E402, F401
 from ballenv.envs import ENV_ID  # noqa: E402
 from ballenv.envs.numerics import ENV_FIDELITIES  # noqa: E402
+from ballenv.files import write_text  # noqa: E402
 from ballenv.physics.base.layout import (
     COUNT_BY_REASON,
     COUNT_IMPULSE_REJECTED,
@@ -223,7 +224,7 @@ def main(argv=None):
         f"{reset:.1f} s, first step {first_step:.1f} s; from the cache: first step {cached_step:.2f} s.\n"
     )
     RESULTS.mkdir(exist_ok=True)
-    (RESULTS / "env_profile.md").write_text(text)
+    write_text(RESULTS / "env_profile.md", text)
     print(text)
 
 

@@ -29,6 +29,7 @@ from tqdm.auto import tqdm  # noqa: E402
 import ballenv  # noqa: E402, F401
 from ballenv.controllers import PaddleDribble, PressurePump  # noqa: E402
 from ballenv.envs.numerics import ENV_FIDELITIES, with_env_fidelity  # noqa: E402
+from ballenv.files import write_text  # noqa: E402
 from ballenv.physics import Ground, Ring, Scene, simulate  # noqa: E402
 from ballenv.physics.base.ring import total_mass  # noqa: E402
 
@@ -186,7 +187,7 @@ def main():
         nodes = ENV_FIDELITIES[preset]["n_nodes"]
         lines.append(f"| {preset} | {nodes} | {apex:.5f} | {err:.2%} | {wall * 1e3:.1f} |")
     text = "\n".join(lines) + "\n"
-    (RESULTS / "env_throughput.md").write_text(text)
+    write_text(RESULTS / "env_throughput.md", text)
     print(text)
     plot(single, vector)
 

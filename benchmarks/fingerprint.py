@@ -34,6 +34,7 @@ import soak  # noqa: E402
 import work_precision as wp  # noqa: E402
 
 from ballenv.envs.inflated_ball import InflatedBallEnv  # noqa: E402
+from ballenv.files import write_text  # noqa: E402
 from ballenv.physics import SimulationError, simulate  # noqa: E402
 from ballenv.physics.build import initial_state  # noqa: E402
 
@@ -152,7 +153,7 @@ def main(argv=None):
     args = parser.parse_args(argv)
     prints = fingerprint(args.scenes, args.episodes)
     if args.out:
-        args.out.write_text(json.dumps(prints, indent=1, sort_keys=True))
+        write_text(args.out, json.dumps(prints, indent=1, sort_keys=True))
         print(f"wrote {args.out}")
     if args.compare:
         diff = differences(json.loads(args.compare.read_text()), json.loads(json.dumps(prints)))

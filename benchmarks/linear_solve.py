@@ -18,6 +18,7 @@ import time  # noqa: E402
 import numpy as np  # noqa: E402
 from numba import njit  # noqa: E402
 
+from ballenv.files import write_text  # noqa: E402
 from ballenv.physics import Ring, Scene  # noqa: E402
 from ballenv.physics.base.linalg import band_to_dense, solve_band_low_rank  # noqa: E402
 from ballenv.physics.build import build_model, build_workspace  # noqa: E402
@@ -80,7 +81,7 @@ def main():
         tb, td, err = measure(n)
         lines.append(f"| {n} | {tb:.1f} | {td:.1f} | {err:.1e} |")
     table = "\n".join(lines)
-    (RESULTS / "linear_solve.md").write_text(table + "\n")
+    write_text(RESULTS / "linear_solve.md", table + "\n")
     print(table)
 
 

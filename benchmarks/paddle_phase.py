@@ -42,6 +42,7 @@ import ballenv  # noqa: E402, F401  (registers the env)
 from agents.baselines import HeuristicPolicy  # noqa: E402
 from agents.wrappers import phase_harmonics, ring_angle, ring_spin, rotation_phase  # noqa: E402
 from ballenv.envs import ENV_IDS  # noqa: E402
+from ballenv.files import write_text  # noqa: E402
 from ballenv.physics.base.ring import total_mass  # noqa: E402
 
 RESULT = ROOT / "benchmarks" / "results" / "paddle_phase.md"
@@ -144,7 +145,7 @@ def main():
         lines.append(f"| {name} | {left:.4f} |")
         print(lines[-1], flush=True)
     RESULT.parent.mkdir(exist_ok=True)
-    RESULT.write_text("\n".join(lines) + "\n")
+    write_text(RESULT, "\n".join(lines) + "\n")
     print(f"wrote {RESULT}")
 
 

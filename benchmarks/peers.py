@@ -68,6 +68,7 @@ import numba  # noqa: E402
 import numpy as np  # noqa: E402
 
 import ballenv  # noqa: E402
+from ballenv.files import write_text  # noqa: E402
 from ballenv.physics import Ground, Ring, Scene, simulate  # noqa: E402
 from ballenv.physics.base.ring import bending_stiffness, inflated_radius, rest_area  # noqa: E402
 from ballenv.physics.presets import FIDELITY_PRESETS, with_fidelity  # noqa: E402
@@ -530,7 +531,7 @@ def main(argv=None):
     cpu_share = (time.process_time() - cpu_start) / wall
     text = report((ref, check), results, headline, ratio, args.quick, wall / 60, cpu_share)
     RESULTS.mkdir(exist_ok=True)
-    (RESULTS / "peers.md").write_text(text)
+    write_text(RESULTS / "peers.md", text)
     print(text)
     return 0
 

@@ -30,7 +30,9 @@ import sys
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
-import numpy as np  # noqa: E402
+import numpy as np
+
+from ballenv.files import write_text  # noqa: E402
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
@@ -257,7 +259,7 @@ def main():
     heuristic = evaluate("heuristic", KWARGS, args.episodes)
     scores = {"episodes": args.episodes, "rows": [lookahead, heuristic, *network_pumps(args.episodes)]}
     text = report(rows, curves, amplitudes, scores)
-    RESULT.write_text(text)
+    write_text(RESULT, text)
     print(text)
 
 

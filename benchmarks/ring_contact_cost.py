@@ -33,6 +33,7 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 
 from collision_cost import NODES, RINGS, lattice  # noqa: E402
 
+from ballenv.files import write_text  # noqa: E402
 from ballenv.physics import Ring, Scene, simulate  # noqa: E402
 from ballenv.physics.build import build_collision_workspace, build_model, build_ring_contact_workspace  # noqa: E402
 from ballenv.physics.walls.impulses import find_contacts  # noqa: E402
@@ -138,7 +139,7 @@ def main():
     for (n_rings, n_nodes), (pairs, contacts) in detection_cost().items():
         lines.append(f"| {n_rings} | {n_nodes} | {pairs * 1e6:.1f} | {contacts * 1e6:.1f} |")
     RESULTS.mkdir(exist_ok=True)
-    (RESULTS / "ring_contact_cost.md").write_text("\n".join(lines) + "\n")
+    write_text(RESULTS / "ring_contact_cost.md", "\n".join(lines) + "\n")
     print("\n".join(lines))
 
 

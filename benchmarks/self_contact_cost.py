@@ -28,6 +28,7 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent.parent))
 
+from ballenv.files import write_text  # noqa: E402
 from ballenv.physics import Ground, Ring, Scene, SimulationError, simulate  # noqa: E402
 
 RESULTS = pathlib.Path(__file__).parent / "results"
@@ -88,7 +89,7 @@ def main():
     ]
     lines += [f"| {n} | {m} | {w:.3f} | {s} | {it} | {o} |" for n, m, w, s, it, o in rows]
     lines += ["", f"Bounce: final state of `barrier` equal to `reject` bit for bit: {same}."]
-    (RESULTS / "self_contact_cost.md").write_text("\n".join(lines) + "\n")
+    write_text(RESULTS / "self_contact_cost.md", "\n".join(lines) + "\n")
 
 
 if __name__ == "__main__":

@@ -50,6 +50,7 @@ sys.path.insert(0, str(ROOT))
 
 from ballenv.cluster import check_cluster, collect, run_tasks, warm_simulator  # noqa: E402
 from ballenv.envs.inflated_ball import InflatedBallEnv  # noqa: E402
+from ballenv.files import write_text  # noqa: E402
 from ballenv.physics import Ground, Ring, Scene  # noqa: E402
 from ballenv.physics.base.ring import inflated_radius  # noqa: E402
 from tests.stability.invariants import (  # noqa: E402
@@ -435,7 +436,7 @@ def main():
     text = "\n".join(lines)
     print(text)
     args.out.parent.mkdir(parents=True, exist_ok=True)
-    args.out.write_text(text)
+    write_text(args.out, text)
 
 
 if __name__ == "__main__":

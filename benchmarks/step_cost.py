@@ -19,6 +19,7 @@ import tempfile  # noqa: E402
 
 import numpy as np  # noqa: E402
 
+from ballenv.files import write_text  # noqa: E402
 from ballenv.physics import Ring, Scene, simulate  # noqa: E402
 from ballenv.physics.base.ring import inflated_radius  # noqa: E402
 
@@ -102,7 +103,7 @@ def main():
         f"start from cache: {cached:.2f} s",
     ]
     table = "\n".join(lines)
-    (RESULTS / "step_cost.md").write_text(table + "\n")
+    write_text(RESULTS / "step_cost.md", table + "\n")
     print(table)
     _plot(rows)
 

@@ -36,6 +36,7 @@ import time  # noqa: E402
 import numpy as np  # noqa: E402
 
 from ballenv.cluster import check_cluster, collect, run_tasks, warm_simulator  # noqa: E402
+from ballenv.files import write_text  # noqa: E402
 from ballenv.physics import Ground, Ring, Scene, simulate  # noqa: E402
 from ballenv.physics.build import initial_state  # noqa: E402
 from ballenv.physics.presets import FIDELITY_PRESETS, with_fidelity  # noqa: E402
@@ -510,7 +511,7 @@ def main(argv=None):
     refs, runs, orders, cor, decay = assemble(names, jobs, results, args.quick)
     text = report(refs, runs, orders, cor, decay, elapsed, args.quick, args.cluster)
     suffix = "_quick" if args.quick else ""
-    (RESULTS / f"work_precision{suffix}.md").write_text(text)
+    write_text(RESULTS / f"work_precision{suffix}.md", text)
     print(text)
     plot_sweeps(refs, runs, RESULTS / f"work_precision{suffix}.png")
     plot_extras(runs["bounce"], refs["bounce"], orders, cor, RESULTS / f"work_precision_pareto{suffix}.png")

@@ -10,7 +10,7 @@ import time
 import numpy as np
 import pytest
 
-from ballenv.cluster import TaskLost, check_cluster, collect, run_tasks
+from ballenv.cluster import TaskFailed, TaskLost, check_cluster, collect, run_tasks
 from ballenv.scenes import run as run_scene
 from tests.benchmark_modules import BENCHMARKS, load_benchmark
 
@@ -129,3 +129,15 @@ def test_the_aws_cluster_configuration_passes_ray_s_schema():
     validate_config(prepare_config(config))  # raises on a field Ray's cluster launcher does not know
     setup = " ".join(config["setup_commands"])
     assert "constraints.txt" in setup and "[ray" in setup  # the pinned install, the ray extra
+
+
+def fails_on_two(x):
+    if x == 2:
+        raise ArithmeticError(f"no square of {x} today")
+    return x * x
+
+
+def test_a_task_that_raises_on_the_cluster_is_kept_beside_the_finished_ones(cluster):
+    results, lost = collect(run_tasks(fails_on_two, [3, 2, 4], cluster, progress=False), 3)
+    assert results == [9, None, 16]
+    assert lost == [TaskFailed(1, "ArithmeticError: no square of 2 today")]

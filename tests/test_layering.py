@@ -20,7 +20,7 @@ PHYSICS_LAYERS = (
 )  # fmt: skip
 # the package's layers, lowest first (a top-level module or sub-package of ballenv, or agents)
 PACKAGE_LAYERS = (
-    ("ballenv.extras", "ballenv.draw", "ballenv.video"),
+    ("ballenv.extras", "ballenv.files", "ballenv.draw", "ballenv.video"),
     ("ballenv.physics",),
     ("ballenv.balls", "ballenv.controllers", "ballenv.cluster", "ballenv.envs"),
     ("ballenv.viewer", "ballenv.scenes", "ballenv.clips", "ballenv.demo", "ballenv"),
@@ -32,7 +32,7 @@ NUMERICS_ONLY = ("gymnasium", "torch", "pygame", "matplotlib", "stable_baselines
 AGENTS_MAY_IMPORT = (
     "ballenv", "ballenv.envs", "ballenv.envs.inflated_ball", "ballenv.envs.config",
     "ballenv.envs.observation", "ballenv.envs.task", "ballenv.controllers", "ballenv.cluster",
-    "ballenv.extras", "ballenv.physics",
+    "ballenv.extras", "ballenv.files", "ballenv.physics",
 )  # fmt: skip
 
 

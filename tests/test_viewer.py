@@ -127,3 +127,25 @@ def test_page_draws_a_drum_as_ground_around_the_ring(tmp_path):
     ring_pixels = np.all(np.abs(pixels - [200, 60, 40]) < 30, axis=1).sum()
     ground = np.all(np.abs(pixels - [150, 150, 150]) < 8, axis=1).sum()
     assert ring_pixels > 100 and ground > 10000, (ring_pixels, ground)
+
+
+HOSTILE_TITLES = [
+    '__DATA__<img src=x onerror="document.body.dataset.pwned=1">',
+    "<!--<script>",
+    "</script><script>document.body.dataset.pwned=1</script>",
+    "__TITLE__ & </title><b>bold</b>",
+]
+
+
+@pytest.mark.parametrize("title", HOSTILE_TITLES)
+def test_a_hostile_title_is_text_and_the_page_still_plays(saved, tmp_path, title):
+    traj, path = saved
+    page = write_html(Trajectory.load(path), tmp_path / "replay.html", title=title)
+    source = page.read_text()
+    data = source.split('<script id="data" type="application/json">')[1].split("</script>")[0]
+    assert json.loads(data)["title"] == title  # the data round-trips, escaped for the script element
+    assert "<" not in data and ">" not in data
+    dom = run_chromium("--virtual-time-budget=2000", "--dump-dom", f"{page.as_uri()}#frame=5")
+    assert dom.returncode == 0, dom.stderr[-2000:]
+    assert 'data-frame="5"' in dom.stdout  # the player ran
+    assert "data-pwned" not in dom.stdout and "<img" not in dom.stdout and "<b>" not in dom.stdout

@@ -80,12 +80,16 @@ class BallEnvConfig:
             ("rest_height", 0.0, 1.0, "m"),
         ):
             s(self, name, check_real(o, name, getattr(self, name), lo, hi, unit))
+        # a strike fits in one control step; the pressure mode never strikes, so any control rate goes
+        paddle = self.action_mode == "paddle"
+        longest = self.control_dt if paddle else 1.0
+        what = "one control step, 1 / control_frequency" if paddle else "1 s"
         s(
             self,
             "paddle_strike_duration",
             check_real(
-                o, "paddle_strike_duration", self.paddle_strike_duration, 0.0, self.control_dt,
-                "s (at most one control step, 1 / control_frequency)", low_open=True,
+                o, "paddle_strike_duration", self.paddle_strike_duration, 0.0, longest, f"s (at most {what})",
+                low_open=True,
             ),
         )  # fmt: skip
         margin = check_real(o, "reward_margin", self.reward_margin, 0.0, 100.0, "", low_open=True)

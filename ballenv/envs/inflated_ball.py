@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 from typing import TYPE_CHECKING, Any
 
 import gymnasium as gym
@@ -117,7 +118,7 @@ class InflatedBallEnv(Env[NDArray[np.float32], NDArray[np.float32]], EzPickle):
     | paddle_max_impulse          | float | 0.15           | impulse of action +1 (N s) |
     | paddle_reach                | float | 0.4            | paddle strikes when the ball's top is this close (m) |
     | paddle_depth                | float | 0.06           | it touches the nodes this close to the top (m) |
-    | paddle_strike_duration      | float | 3e-3           | a strike delivers its impulse over this time, in (0, 1 / control_frequency] (s) |
+    | paddle_strike_duration      | float | 3e-3           | a strike delivers its impulse over this time, in (0, 1 / control_frequency] (s) in paddle mode, (0, 1] in pressure mode |
     | radius                      | float | 0.12           | unstretched ring radius R (m) |
     | youngs_modulus              | float | 10e6           | wall modulus E (Pa) |
     | thickness                   | float | 2e-3           | wall thickness h (m) |
@@ -235,6 +236,19 @@ class InflatedBallEnv(Env[NDArray[np.float32], NDArray[np.float32]], EzPickle):
             sim_failure_reason=failure_message(task, 0),
         )
         return info
+
+    def __deepcopy__(self, memo: dict[int, Any]) -> InflatedBallEnv:
+        """A copy in the same episode: the same settings, and the simulator's, the task's and the
+        random generator's state copied, so it steps exactly as this env would (a renderer is not
+        copied; the copy makes its own when it draws)."""
+        kwargs: dict[str, Any] = dict(self._ezpickle_kwargs)
+        other = type(self)(**kwargs)  # EzPickle keeps the keywords it was made with
+        other._batch.copy_env(self._batch, 0, np.zeros(1, dtype=np.int64))
+        other._actions[:] = self._actions
+        other._has_reset = self._has_reset
+        other._np_random = copy.deepcopy(self._np_random, memo)
+        other._np_random_seed = self._np_random_seed
+        return other
 
     def render(self) -> NDArray[np.uint8] | None:
         if self.render_mode is None:

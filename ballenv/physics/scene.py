@@ -118,17 +118,22 @@ def check_choice(owner: str, name: str, value: object, choices: Sequence[str]) -
     return value
 
 
+MIN_RADIUS = 1e-3  # m: the smallest ring (its wall modes outrun any allowed step below it)
+MIN_DENSITY = 1.0  # kg/m^3: the lightest wall
+
+
 @dataclass(frozen=True)
 class Ring:
     """One inflated elastic ring (a 2-D ball).
 
     Attributes:
-        radius: rest radius R of the centreline circle (m), in (0, 100].
+        radius: rest radius R of the centreline circle (m), in [1e-3, 100] (a millimetre and up: below, the
+            wall's modes outrun any step the scene allows).
         n_nodes: number of nodes N, in [3, 4096].
         youngs_modulus: E of the wall (Pa), in (0, 1e12].
         thickness: wall thickness h (m), in (0, radius).
         width: out-of-plane width b (m), in (0, 100].
-        density: wall density rho (kg/m^3), in (0, 1e5].
+        density: wall density rho (kg/m^3), in [1, 1e5] (lighter than any solid wall stays out).
         pressure: gauge pressure (Pa) of the inflated ball at rest, in
             [max(-1e8, -E h / (R cos(pi/N))), min(1e8, E h / (2 R cos(pi/N)))] (the wall compressed by
             50 %, stretched by 100 %), or None for no gas at all. Negative: an under-inflated ball or
@@ -137,7 +142,7 @@ class Ring:
             its wall tension holds this pressure (radius ``R / (1 - p b R cos(pi/N) / EA)``); the amount
             of gas is fixed there and the gas law sets the pressure as the ring deforms (or, with
             ``Scene.gas_exponent`` 0, a regulator holds it).
-        position: initial centre (m).
+        position: initial centre (m), each component in [-1e6, 1e6].
         velocity: initial centre velocity (m/s), each component in [-1000, 1000].
         angular_velocity: initial spin (rad/s, counter-clockwise), in [-1e5, 1e5].
     """
@@ -156,7 +161,7 @@ class Ring:
     def __post_init__(self) -> None:
         o = "Ring"
         s = object.__setattr__
-        s(self, "radius", check_real(o, "radius", self.radius, 0.0, 100.0, "m", low_open=True))
+        s(self, "radius", check_real(o, "radius", self.radius, MIN_RADIUS, 100.0, "m"))
         s(self, "n_nodes", check_int(o, "n_nodes", self.n_nodes, 3, 4096))
         s(
             self,
@@ -169,7 +174,7 @@ class Ring:
             check_real(o, "thickness", self.thickness, 0.0, self.radius, "m (below radius)", True, True),
         )
         s(self, "width", check_real(o, "width", self.width, 0.0, 100.0, "m", low_open=True))
-        s(self, "density", check_real(o, "density", self.density, 0.0, 1e5, "kg/m^3", True))
+        s(self, "density", check_real(o, "density", self.density, MIN_DENSITY, 1e5, "kg/m^3"))
         if self.pressure is not None:
             # inflated strain q / (1 - q) with q = p R cos(pi/N) / (E h): in [-50 %, 100 %]
             s(self, "pressure", check_gauge_pressure(o, "pressure", self.pressure, self))

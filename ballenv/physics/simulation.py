@@ -77,6 +77,8 @@ RECORDS = 1024  # starting room of the recording when every step is recorded (it
 # factors on Scene.friction_regularization that Newton's rescue of a step tries in turn (_rescued)
 RESCUE_REGULARIZATION = (1.0, 10.0, 100.0)
 SHORTEST_EDGE = 1e-6  # shortest edge of a starting ring (fraction of its rest edge length)
+# largest |entry| of a starting state: positions as Ring.position's, node speeds 1000 x Ring.velocity's
+STATE_BOUNDS = {"x0": (1e6, "m"), "v0": (1e6, "m/s")}
 
 
 class SimulationError(RuntimeError):
@@ -400,6 +402,12 @@ def _check_state(
         raise ValueError(f"{caller}.{name} has shape {arr.shape}: must be {shape} (m or m/s)")
     if not np.all(np.isfinite(arr)):
         raise ValueError(f"{caller}.{name} contains NaN or inf: must be finite")
+    bound, unit = STATE_BOUNDS[name]
+    if np.any(np.abs(arr) > bound):
+        raise ValueError(
+            f"{caller}.{name} has an entry of {np.abs(arr).max():.3g} {unit}: "
+            f"each must be in [-{bound:g}, {bound:g}]"
+        )
     return arr.copy()
 
 

@@ -33,7 +33,9 @@ import dataclasses
 import json
 import os
 import pathlib
+import struct
 import zipfile
+import zlib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -41,6 +43,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..files import atomic_path
 from .base.layout import EVENT_APEX, EVENT_HEIGHT, EVENT_KIND, EVENT_RING, EVENT_T
 from .build import build_barrier_workspace, build_model, build_ring_contact_workspace
 from .effects.assembly import ENERGY_PARTS, ring_energy
@@ -49,6 +52,12 @@ from .scene import Drum, Ground, Ring, Scene
 from .step.energy_budget import self_contact_energy
 from .step.events import EVENT_KINDS, event_list
 from .walls.ring_barrier import contact_energy_by_ring, pairs_per_node
+
+FORMAT = "ballenv.trajectory"
+VERSION = 1
+ARRAYS = ("t", "x", "v", "pressure", "contact_force", "event_table")
+MAX_LOAD_BYTES = 2**31  # default cap on the arrays a file may declare, decompressed (2 GiB)
+MAX_RECORD_CHARS = 2**20  # cap on the scene's and the statistics' JSON (characters)
 
 
 @dataclass(frozen=True)
@@ -137,9 +146,11 @@ class Trajectory:
         return save(self, path)
 
     @classmethod
-    def load(cls, path: str | os.PathLike[str]) -> Trajectory:
-        """A trajectory saved by :meth:`save`, exactly as it was (ValueError on a foreign file)."""
-        return load(path)
+    def load(cls, path: str | os.PathLike[str], max_bytes: int = MAX_LOAD_BYTES) -> Trajectory:
+        """A trajectory saved by :meth:`save`, exactly as it was. The file is trusted for nothing:
+        anything wrong with it, or arrays declaring more than ``max_bytes`` (bytes, decompressed;
+        default 2 GiB), is one ValueError naming the file (:func:`load`)."""
+        return load(path, max_bytes)
 
 
 def energy(scene: Scene, x: ArrayLike, v: ArrayLike) -> dict[str, NDArray[np.float64]]:
@@ -179,11 +190,6 @@ def _contact_energy_by_ring(model: Model, states: NDArray[np.float64]) -> NDArra
     return out
 
 
-FORMAT = "ballenv.trajectory"
-VERSION = 1
-ARRAYS = ("t", "x", "v", "pressure", "contact_force", "event_table")
-
-
 def scene_to_dict(scene: Scene) -> dict[str, Any]:
     """``scene`` as a JSON-ready dict (rings, grounds and drums as lists of field dicts)."""
     out = {}
@@ -213,13 +219,22 @@ def _tupled(ring: Mapping[str, Any]) -> dict[str, Any]:
 
 
 def save(traj: Trajectory, path: str | os.PathLike[str]) -> pathlib.Path:
-    """Write ``traj`` to ``path`` (``.npz`` is appended by NumPy if missing); returns the path."""
+    """Write ``traj`` to ``path`` (``.npz`` appended if missing), atomically: the file appears whole
+    or not at all (:func:`ballenv.files.atomic_path`); returns the path."""
     path = pathlib.Path(path)
     if path.suffix != ".npz":
         path = path.with_name(path.name + ".npz")
     table = traj.event_table if traj.event_table is not None else np.zeros((0, 4))
     stats = dataclasses.asdict(traj.stats)
     stats["effects"] = list(stats["effects"])
+    with atomic_path(path) as tmp:  # a kill while writing leaves an existing file as it was
+        _write_archive(tmp, traj, table, stats)
+    return path
+
+
+def _write_archive(
+    path: pathlib.Path, traj: Trajectory, table: NDArray[np.float64], stats: dict[str, Any]
+) -> None:
     np.savez_compressed(
         path,
         format=np.array(FORMAT),
@@ -233,67 +248,51 @@ def save(traj: Trajectory, path: str | os.PathLike[str]) -> pathlib.Path:
         scene=np.array(json.dumps(scene_to_dict(traj.scene))),
         stats=np.array(json.dumps(stats)),
     )
-    return path
 
 
-def load(path: str | os.PathLike[str]) -> Trajectory:
-    """Read a trajectory written by :func:`save`; a missing or foreign file raises ValueError
-    (FileNotFoundError if it does not exist)."""
+# what may go wrong inside a file that is not ours (every one becomes the loader's ValueError)
+UNREADABLE = (
+    OSError, EOFError, zipfile.BadZipFile, zlib.error, KeyError, TypeError, IndexError,
+    RecursionError, UnicodeDecodeError, OverflowError, struct.error,
+)  # fmt: skip
 
+
+def load(path: str | os.PathLike[str], max_bytes: int = MAX_LOAD_BYTES) -> Trajectory:
+    """Read a trajectory written by :func:`save`. The file is trusted for nothing: every array's
+    declared dtype and shape are checked against the scene before anything is decompressed, the
+    arrays together may not declare more than ``max_bytes`` (bytes, decompressed), and anything
+    wrong with it raises one ValueError naming the file (FileNotFoundError if it does not exist)."""
     path = pathlib.Path(path)
     if not path.exists():
         raise FileNotFoundError(f"Trajectory.load: no such file: {path}")
     if not zipfile.is_zipfile(path):
         raise ValueError(f"Trajectory.load: {path} is not a .npz archive (not a zip file)")
     try:
-        archive = np.load(path, allow_pickle=False)
-    except (OSError, ValueError, zipfile.BadZipFile) as err:
-        raise ValueError(f"Trajectory.load: {path} is not a .npz archive ({err})") from err
-    with archive:
-        keys = set(archive.files)
-        if "format" not in keys or str(archive["format"]) != FORMAT:
-            raise ValueError(
-                f"Trajectory.load: {path} is not a ballenv trajectory (no format = {FORMAT!r}; "
-                f"keys: {sorted(keys)})"
-            )
-        version = int(archive["version"]) if "version" in keys else None
-        if version != VERSION:
-            raise ValueError(
-                f"Trajectory.load: {path} has layout version {version}, this ballenv reads {VERSION}"
-            )
-        missing = [k for k in (*ARRAYS, "scene", "stats") if k not in keys]
-        if missing:
-            raise ValueError(f"Trajectory.load: {path} lacks {', '.join(missing)}")
-        arrays = {k: archive[k] for k in ARRAYS}
-        try:
-            scene = scene_from_dict(json.loads(str(archive["scene"])))
-            stats = json.loads(str(archive["stats"]))
-        except (ValueError, TypeError, KeyError) as err:
-            raise ValueError(f"Trajectory.load: {path} has an invalid scene or stats record ({err})") from err
-    t, x = arrays["t"], arrays["x"]
-    n_rings, n_nodes = len(scene.rings), scene.rings[0].n_nodes
-    shapes = {
-        "x": (len(t), n_rings, n_nodes, 2),
-        "v": (len(t), n_rings, n_nodes, 2),
-        "pressure": (len(t), n_rings),
-        "contact_force": (len(t), n_rings, n_nodes, 2),
-    }
-    for key, shape in shapes.items():
-        if arrays[key].shape != shape:
-            raise ValueError(
-                f"Trajectory.load: {path}: {key} has shape {arrays[key].shape}, expected {shape}"
-            )
+        return _load(path, max_bytes)
+    except ValueError as err:
+        if str(err).startswith("Trajectory.load:"):
+            raise
+        raise ValueError(f"Trajectory.load: {path} is not a readable ballenv trajectory ({err})") from err
+    except UNREADABLE as err:
+        message = f"{type(err).__name__}: {err}"
+        raise ValueError(f"Trajectory.load: {path} is not a readable ballenv trajectory ({message})") from err
+
+
+def _load(path: pathlib.Path, max_bytes: int) -> Trajectory:
+    with zipfile.ZipFile(path) as archive:
+        headers = _headers(path, archive)
+        _check_records(path, archive, headers)
+        scene, stats = _records(path, archive)
+        _check_arrays(path, headers, scene, max_bytes)
+        arrays = {k: _member(archive, k) for k in ARRAYS}
     table = arrays["event_table"]
-    if (
-        table.ndim != 2
-        or table.shape[1] != 4
-        or np.any((table[:, 2] < 0) | (table[:, 2] >= len(EVENT_KINDS)))
-    ):
-        raise ValueError(f"Trajectory.load: {path}: event_table must be (E, 4) rows with known event kinds")
+    kinds, rings = table[:, 2], table[:, 1]
+    if np.any((kinds < 0) | (kinds >= len(EVENT_KINDS))) or np.any((rings < 0) | (rings >= len(scene.rings))):
+        raise ValueError(f"Trajectory.load: {path}: event_table rows name unknown event kinds or rings")
     stats["effects"] = tuple(stats["effects"])
     return Trajectory(
-        t=t,
-        x=x,
+        t=arrays["t"],
+        x=arrays["x"],
         v=arrays["v"],
         pressure=arrays["pressure"],
         contact_force=arrays["contact_force"],
@@ -302,3 +301,94 @@ def load(path: str | os.PathLike[str]) -> Trajectory:
         scene=scene,
         event_table=table,
     )
+
+
+def _headers(
+    path: pathlib.Path, archive: zipfile.ZipFile
+) -> dict[str, tuple[tuple[int, ...], np.dtype[Any]]]:
+    """Shape and dtype of each ``.npy`` member, read from its header (a few bytes decompressed)."""
+    out = {}
+    for name in archive.namelist():
+        if not name.endswith(".npy"):
+            raise ValueError(f"Trajectory.load: {path} holds {name!r}, not a .npy array")
+        with archive.open(name) as member:
+            version = np.lib.format.read_magic(member)
+            if version not in ((1, 0), (2, 0)):
+                raise ValueError(f"Trajectory.load: {path}: {name} has .npy version {version}")
+            read = (
+                np.lib.format.read_array_header_1_0
+                if version == (1, 0)
+                else np.lib.format.read_array_header_2_0
+            )
+            shape, _, dtype = read(member)
+        out[name[: -len(".npy")]] = (tuple(int(n) for n in shape), dtype)
+    return out
+
+
+def _check_records(path: pathlib.Path, archive: zipfile.ZipFile, headers: dict[str, Any]) -> None:
+    """The format, version, scene and statistics records: present, scalar, of their types, bounded."""
+    missing = [k for k in ("format", "version", *ARRAYS, "scene", "stats") if k not in headers]
+    if "format" in missing:
+        raise ValueError(f"Trajectory.load: {path} is not a ballenv trajectory (no format = {FORMAT!r})")
+    for key in ("format", "scene", "stats"):
+        if key in headers and (headers[key][0] != () or headers[key][1].kind != "U"):
+            raise ValueError(f"Trajectory.load: {path}: {key} must be a string, not {headers[key]}")
+        if key in headers and headers[key][1].itemsize // 4 > MAX_RECORD_CHARS:
+            raise ValueError(f"Trajectory.load: {path}: {key} is longer than {MAX_RECORD_CHARS} characters")
+    if str(_member(archive, "format")) != FORMAT:
+        raise ValueError(f"Trajectory.load: {path} is not a ballenv trajectory (format is not {FORMAT!r})")
+    if "version" in missing or headers["version"] != ((), np.dtype(np.int64)):
+        raise ValueError(f"Trajectory.load: {path} has no int64 layout version, this ballenv reads {VERSION}")
+    version = int(_member(archive, "version"))
+    if version != VERSION:
+        raise ValueError(
+            f"Trajectory.load: {path} has layout version {version}, this ballenv reads {VERSION}"
+        )
+    if missing:
+        raise ValueError(f"Trajectory.load: {path} lacks {', '.join(missing)}")
+
+
+def _records(path: pathlib.Path, archive: zipfile.ZipFile) -> tuple[Scene, dict[str, Any]]:
+    """The scene (validated by ``Scene`` itself) and the statistics' fields."""
+    try:
+        scene = scene_from_dict(json.loads(str(_member(archive, "scene"))))
+        stats = json.loads(str(_member(archive, "stats")))
+        if not isinstance(stats, dict) or set(stats) != {f.name for f in dataclasses.fields(SimulationStats)}:
+            raise ValueError("the statistics' fields are not SimulationStats'")
+        SimulationStats(**{**stats, "effects": tuple(stats["effects"])})
+    except (ValueError, TypeError, KeyError, AttributeError, RecursionError) as err:
+        raise ValueError(f"Trajectory.load: {path} has an invalid scene or stats record ({err})") from err
+    return scene, stats
+
+
+def _check_arrays(path: pathlib.Path, headers: dict[str, Any], scene: Scene, max_bytes: int) -> None:
+    """Every array float64 and of the shape the scene and the record count give, and all of them
+    together within ``max_bytes`` (decompressed), before any is read."""
+    n_records = headers["t"][0][0] if len(headers["t"][0]) == 1 else -1
+    n_rings, n_nodes = len(scene.rings), scene.rings[0].n_nodes
+    shapes = {
+        "t": (n_records,),
+        "x": (n_records, n_rings, n_nodes, 2),
+        "v": (n_records, n_rings, n_nodes, 2),
+        "pressure": (n_records, n_rings),
+        "contact_force": (n_records, n_rings, n_nodes, 2),
+        "event_table": (headers["event_table"][0][0] if headers["event_table"][0] else -1, 4),
+    }
+    total = 0
+    for key, shape in shapes.items():
+        got, dtype = headers[key]
+        if got != shape or -1 in shape:
+            raise ValueError(f"Trajectory.load: {path}: {key} has shape {got}, expected {shape}")
+        if dtype != np.dtype(np.float64):
+            raise ValueError(f"Trajectory.load: {path}: {key} has dtype {dtype}, expected float64")
+        total += int(np.prod(shape)) * 8
+    if total > max_bytes:
+        raise ValueError(
+            f"Trajectory.load: {path} declares {total} bytes of arrays, more than max_bytes = {max_bytes}"
+        )
+
+
+def _member(archive: zipfile.ZipFile, key: str) -> NDArray[Any]:
+    """The array ``key`` of the archive (its header already checked), without pickles."""
+    with archive.open(key + ".npy") as member:
+        return np.lib.format.read_array(member, allow_pickle=False)

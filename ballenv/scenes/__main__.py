@@ -19,6 +19,7 @@ import sys
 import time
 
 from ..cluster import check_cluster
+from ..files import write_text
 from ..video import FORMATS
 from . import SCENES, get, run
 
@@ -67,7 +68,7 @@ def run_one(
         "parameters": _jsonable(result.parameters),
         "metrics": _jsonable(result.metrics),
     }
-    (out / f"{name}.json").write_text(json.dumps(record, indent=1))
+    write_text(out / f"{name}.json", json.dumps(record, indent=1))
     paths.append(out / f"{name}.json")
     if save:
         for label, traj in result.trajectories.items():

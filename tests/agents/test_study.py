@@ -2,6 +2,7 @@
 serially and on a local Ray cluster."""
 
 import json
+import pathlib
 
 import numpy as np
 import pytest
@@ -117,3 +118,22 @@ def test_a_seed_lost_with_its_worker_is_left_out_and_named(monkeypatch, capsys):
     args.seeds = [0]
     with pytest.raises(RuntimeError, match=r"every training seed of \[0\] was lost"):
         train_seeds(args, {"action_mode": "pressure"})
+
+
+def test_an_interrupted_seed_resumes_and_one_without_a_saved_state_is_moved_aside(tmp_path, monkeypatch):
+    import agents.study as study
+
+    calls = []
+    monkeypatch.setattr(study, "train", lambda args: calls.append(args) or pathlib.Path(args.resume or "new"))
+    job = study.SeedJob("ppo", "pressure", 0, 256, 2, tmp_path, {})
+    run = tmp_path / "ppo_pressure_seed0"
+    (run / "resume").mkdir(parents=True)
+    (run / "resume" / "state.json").write_text('{"num_timesteps": 128}')
+    assert study.train_seed(job) == run and calls[-1].resume == str(run)
+    (run / "resume" / "state.json").unlink()
+    study.train_seed(job)
+    assert calls[-1].resume is None and calls[-1].seed == 0  # trained again under its own name
+    assert (tmp_path / "ppo_pressure_seed0.incomplete").exists() and not run.exists()
+    (tmp_path / "ppo_pressure_seed0").mkdir()
+    (tmp_path / "ppo_pressure_seed0" / "scores.json").write_text("[]")
+    assert study.train_seed(job) == run and len(calls) == 2  # finished: reused

@@ -32,7 +32,8 @@ def test_train_runs_end_to_end_and_the_saved_agent_reloads(algo, mode, tmp_path)
     done = subprocess.run(command, cwd=ROOT, capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stderr[-3000:]
     run = tmp_path / f"{algo}_{mode}_seed3"
-    saved = ["model.zip", "vecnormalize.pkl", "best_model.zip", "best_vecnormalize.pkl", "config.yml"]
+    saved = ["model.zip", "vecnormalize.npz", "best_model.zip", "best_vecnormalize.npz", "config.yml"]
+    saved += ["signatures.json"]
     saved += ["command.txt", "evaluations.npz", "scores.md", "scores.json", "learning_curve.png"]
     for name in saved:
         assert (run / name).exists(), name

@@ -312,20 +312,18 @@ def _return_behind(cls, run, steps):
     """The return of the first held-out episode (``agents.evaluate``'s seed) of ``run``'s best model
     stepping the env behind ``cls`` itself, as in training (observations normalised with the saved
     statistics)."""
-    import pickle
-
     from stable_baselines3 import PPO
 
     from agents.evaluate import DEFAULT_SEED
+    from agents.normalization import load
 
     model = PPO.load(run / "best_model.zip", device="cpu")
-    with open(run / "best_vecnormalize.pkl", "rb") as f:
-        normalize = pickle.load(f)
+    normalize = load(run / "best_vecnormalize.npz")
     env = cls(gym.make("InflatedBall-v3", max_episode_steps=steps))
     obs, _ = env.reset(seed=DEFAULT_SEED)
     total, done = 0.0, False
     while not done:
-        action, _ = model.predict(normalize.normalize_obs(obs).astype(np.float32), deterministic=True)
+        action, _ = model.predict(normalize.apply(obs), deterministic=True)
         obs, reward, terminated, truncated, _ = env.step(action)
         total += float(reward)
         done = terminated or truncated

@@ -1,6 +1,7 @@
 """InflatedBall-v3 as Gymnasium and Stable-Baselines3 expect it: checkers, seeding, pickling,
 clear errors (extreme actions: tests/stability/test_env_extreme_actions.py)."""
 
+import copy
 import pickle
 import warnings
 
@@ -220,3 +221,27 @@ def test_ball_env_finds_the_env_under_wrappers_and_refuses_other_envs():
     assert isinstance(ball_env(env), InflatedBallEnv) and ball_env(env) is env.unwrapped
     with pytest.raises(TypeError, match="not an InflatedBall env"):
         ball_env(gym.make("CartPole-v1"))
+
+
+@pytest.mark.parametrize("env_id", ["InflatedBall-v3", "InflatedBallPaddle-v3"])
+def test_a_deep_copy_mid_episode_steps_as_the_original(env_id):
+    env = gym.make(env_id).unwrapped
+    env.reset(seed=3)
+    rng = np.random.default_rng(0)
+    for _ in range(20):
+        env.step(rng.uniform(-1, 1, 1).astype(np.float32))
+    twin = copy.deepcopy(env)
+    for _ in range(40):
+        action = rng.uniform(-1, 1, 1).astype(np.float32)
+        first, second = env.step(action), twin.step(action)
+        np.testing.assert_array_equal(first[0], second[0])
+        assert first[1:4] == second[1:4]
+        if first[2]:
+            break
+    np.testing.assert_array_equal(env.reset()[0], twin.reset()[0])  # the random generator too
+
+
+def test_the_pressure_mode_takes_any_control_rate_the_paddle_one_its_strike():
+    gym.make("InflatedBall-v3", control_frequency=500.0).close()  # no strike in this mode
+    with pytest.raises(ValueError, match="paddle_strike_duration = 0.003 is out of range"):
+        gym.make("InflatedBallPaddle-v3", control_frequency=500.0)

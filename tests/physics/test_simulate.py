@@ -201,3 +201,26 @@ def test_output_dt_records_exact_times_and_stats():
     assert traj.stats.rejected_steps == 0
     assert traj.stats.newton_iterations >= traj.stats.steps
     assert traj.stats.effects == ("stretching", "bending", "pressure", "gravity")
+
+
+@pytest.mark.parametrize(
+    ("name", "change", "message"),
+    [
+        ("v0", lambda x, v: (x, v + 1e20), r"simulate.v0 has an entry of 1e\+20 m/s: each must be in"),
+        ("x0", lambda x, v: (x + 1e12, v), r"simulate.x0 has an entry of 1e\+12 m: each must be in"),
+        ("x0", lambda x, v: (x * 1e200, v), r"simulate.x0 has an entry of .* m: each must be in"),
+    ],
+)
+def test_a_start_state_past_its_bounds_is_a_clear_error(name, change, message):
+    from ballenv.physics.build import initial_state
+
+    scene = Scene(rings=[Ring(n_nodes=16)])
+    x, v = change(*initial_state(scene))
+    with pytest.raises(ValueError, match=message):
+        simulate(scene, 0.01, x0=x, v0=v)
+
+
+@pytest.mark.parametrize(("field", "value"), [("radius", 1e-9), ("density", 1e-300)])
+def test_rings_too_small_or_too_light_to_step_are_refused_by_name(field, value):
+    with pytest.raises(ValueError, match=f"Ring.{field} = {value:g} is out of range"):
+        Ring(**{field: value, "thickness": 1e-10} if field == "radius" else {field: value})

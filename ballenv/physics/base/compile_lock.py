@@ -9,13 +9,20 @@ and each compiles the same code (tens of seconds of CPU each, for the simulator'
 Python-called kernel (:func:`.jit.python_entry`) takes a lock file named after its source file, name
 and argument types (``filelock``: fcntl/msvcrt, released if the process dies) around numba's
 compilation, which looks in the disk cache again first, so a process that waited loads what the
-first one wrote. A process waiting says so (:func:`.compile_notice.log_info`). Where no lock file can
-be made (a read-only temporary directory), the kernel compiles without one.
+first one wrote. A process waiting says so (:func:`.compile_notice.log_info`).
+
+The lock files live in a folder of the user's own (``$XDG_CACHE_HOME/ballenv/compile-locks``, by
+default ``~/.cache/ballenv/compile-locks``; ``BALLENV_LOCK_DIR`` overrides it), made with
+permissions 0700 and used only if it is a real folder (not a symbolic link) owned by the user, so
+another user can neither hold a lock nor plant a link. A process waits at most ``WAIT_LIMIT``
+(s) for another's compilation (a stopped process may hold a lock for ever), then compiles on its
+own and says so. Where no private lock folder can be had (a read-only home, a foreign owner), the
+kernel compiles without a lock, as numba does.
 """
 
 import hashlib
 import os
-import tempfile
+import stat
 
 from filelock import FileLock, Timeout
 from numba.core import config, sigutils
@@ -23,9 +30,33 @@ from numba.core.registry import CPUDispatcher
 
 from .compile_notice import log_info
 
-USER = os.getuid() if hasattr(os, "getuid") else 0  # one lock directory per user (POSIX)
-LOCK_DIR = os.path.join(tempfile.gettempdir(), f"ballenv-compile-{USER}")
+WAIT_LIMIT = 900.0  # s: the longest wait for another process's compilation (a cold step: minutes)
 WAITING = "waiting for another process compiling the simulator (%s); it then loads from the cache"
+GAVE_UP = "waited %.0f s for another process compiling the simulator (%s); compiling it here instead"
+
+
+def lock_dir():
+    """The folder of the lock files (see the module doc)."""
+    given = os.environ.get("BALLENV_LOCK_DIR")
+    if given:
+        return given
+    cache = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return os.path.join(cache, "ballenv", "compile-locks")
+
+
+def private_dir(path):
+    """``path`` made (0700) if missing; True if it is a real folder owned by this user, never a
+    symbolic link, with no access for others."""
+    try:
+        os.makedirs(path, mode=0o700, exist_ok=True)
+        info = os.lstat(path)
+    except OSError:
+        return False
+    if not stat.S_ISDIR(info.st_mode) or stat.S_ISLNK(info.st_mode):
+        return False
+    if hasattr(os, "getuid") and (info.st_uid != os.getuid() or info.st_mode & 0o077):
+        return False
+    return True
 
 
 def lock_path(dispatcher, signature):
@@ -33,7 +64,7 @@ def lock_path(dispatcher, signature):
     cache directory (``NUMBA_CACHE_DIR``, or beside the source)."""
     function = dispatcher.py_func
     key = repr((config.CACHE_DIR, function.__code__.co_filename, function.__qualname__, signature))
-    return os.path.join(LOCK_DIR, hashlib.sha256(key.encode()).hexdigest()[:32] + ".lock")
+    return os.path.join(lock_dir(), hashlib.sha256(key.encode()).hexdigest()[:32] + ".lock")
 
 
 class SharedCompile(CPUDispatcher):
@@ -42,19 +73,31 @@ class SharedCompile(CPUDispatcher):
 
     def compile(self, sig):
         args, _ = sigutils.normalize_signature(sig)
-        if tuple(args) in self.overloads:
+        if tuple(args) in self.overloads or not private_dir(lock_dir()):
             return super().compile(sig)
+        lock = FileLock(lock_path(self, tuple(args)))
         try:
-            os.makedirs(LOCK_DIR, exist_ok=True)
-            lock = FileLock(lock_path(self, tuple(args)))
-            try:
-                lock.acquire(timeout=0)
-            except Timeout:
-                log_info(WAITING, self.py_func.__name__)
-                lock.acquire()
+            held = _acquire(lock, self.py_func.__name__)
         except OSError:
             return super().compile(sig)
         try:
             return super().compile(sig)
         finally:
-            lock.release()
+            if held:
+                lock.release()
+
+
+def _acquire(lock, name):
+    """Take ``lock`` at once, or after waiting for the process that holds it (saying so), at most
+    ``WAIT_LIMIT`` s; False if it is still held then (this process then compiles without it)."""
+    try:
+        lock.acquire(timeout=0)
+        return True
+    except Timeout:
+        log_info(WAITING, name)
+    try:
+        lock.acquire(timeout=WAIT_LIMIT)
+        return True
+    except Timeout:
+        log_info(GAVE_UP, WAIT_LIMIT, name)
+        return False

@@ -26,9 +26,10 @@ import types
 from numba import njit
 from numba.core.registry import CPUDispatcher
 
+from . import cache_location
 from .compile_lock import SharedCompile
 
-OPTIONS = {"cache": True, "_nrt": False}
+OPTIONS = {"cache": cache_location.apply(), "_nrt": False}  # no cache only where nothing is writable
 WRAPPERS = ("no_cpython_wrapper", "no_cfunc_wrapper")
 
 
@@ -53,7 +54,7 @@ def python_entry(dispatcher):
         g.__qualname__ = f.__qualname__ + ".python"
         g.__module__, g.__doc__, g.__kwdefaults__ = f.__module__, f.__doc__, f.__kwdefaults__
         options = {k: v for k, v in dispatcher.targetoptions.items() if k not in WRAPPERS and k != "nopython"}
-        twin = dispatcher._twin = njit(cache=True, **options)(g)
+        twin = dispatcher._twin = njit(cache=OPTIONS["cache"], **options)(g)
         twin.__class__ = SharedCompile  # compiled once across processes (compile_lock.py)
     return twin
 

@@ -1,13 +1,17 @@
 """One compilation of a kernel's signature across processes (``ballenv.physics.base.compile_lock``)."""
 
 import json
+import logging
 import os
+import stat
 import subprocess
 import sys
 import time
 
-from ballenv.physics.base import jit
-from ballenv.physics.base.compile_lock import SharedCompile
+from numba.core import types
+
+from ballenv.physics.base import compile_lock, jit
+from ballenv.physics.base.compile_lock import SharedCompile, private_dir
 from ballenv.physics.walls.self_barrier import point_edge_distance2
 
 CALL_ON_GO = """
@@ -50,3 +54,53 @@ def test_processes_calling_a_new_signature_at_once_compile_it_once(tmp_path):
         assert p.returncode == 0
         runs.append(tuple(json.loads(out.strip().splitlines()[-1])))
     assert sorted(runs) == [(0, 1), (1, 0)]  # one compiled it, the other waited and loaded it
+
+
+def test_the_lock_folder_is_private_and_never_a_link(tmp_path):
+    fresh = tmp_path / "locks"
+    assert private_dir(str(fresh))
+    assert stat.S_IMODE(fresh.stat().st_mode) == 0o700
+    target = tmp_path / "elsewhere"
+    target.mkdir(mode=0o700)
+    link = tmp_path / "planted"
+    link.symlink_to(target)
+    assert not private_dir(str(link))  # a link planted by someone else is not followed
+    shared = tmp_path / "shared"
+    shared.mkdir()
+    shared.chmod(0o777)
+    assert not private_dir(str(shared))  # others may write there
+
+
+HOLD_AND_STOP = """
+import os, signal, sys
+from filelock import FileLock
+lock = FileLock(sys.argv[1])
+lock.acquire()
+print("held", flush=True)
+os.kill(os.getpid(), signal.SIGSTOP)  # a compiling process stopped for good
+"""
+
+
+def test_a_stopped_holder_is_waited_for_at_most_the_limit_then_compiled_past(tmp_path, monkeypatch, caplog):
+    caplog.set_level(logging.INFO, logger="ballenv")
+    monkeypatch.setenv("BALLENV_LOCK_DIR", str(tmp_path / "locks"))
+    monkeypatch.setattr(compile_lock, "WAIT_LIMIT", 0.5)
+    twin = jit.python_entry(jit.kernel(_scaled))
+    assert private_dir(compile_lock.lock_dir())
+    path = compile_lock.lock_path(twin, (types.float64,))
+    holder = subprocess.Popen([sys.executable, "-c", HOLD_AND_STOP, path], stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline().strip() == "held"
+        start = time.monotonic()
+        assert twin(2.0) == 6.0
+        assert 0.5 <= time.monotonic() - start < 60
+    finally:
+        holder.kill()
+        holder.wait()
+    err = caplog.text
+    assert "waiting for another process compiling the simulator (_scaled)" in err
+    assert "waited 0 s for another process compiling the simulator (_scaled); compiling it here" in err
+
+
+def _scaled(x):
+    return 3.0 * x
