@@ -63,5 +63,6 @@ format: $(STAMP)
 clean: clean-cache
 	rm -rf $(VENV) out runs site .pytest_cache .ruff_cache .mypy_cache
 
-clean-cache:  # numba's compiled kernels (stale after editing a kernel that other files call)
+clean-cache:  # numba's compiled kernels (every source version's) and Python's bytecode
+	rm -rf "$${XDG_CACHE_HOME:-$$HOME/.cache}/ballenv/numba"
 	find . -name __pycache__ -type d -not -path "./$(VENV)/*" -prune -exec rm -rf {} +

@@ -20,7 +20,8 @@ other task are kept; a task whose ``fn`` raised on the cluster is yielded as :cl
 whether its task was retried or not. In the serial run an exception of ``fn`` is raised at once.
 
 numba compiles the simulator's kernels on first use (a minute or more) and caches them on disk, in the
-package's ``__pycache__`` folders (or ``NUMBA_CACHE_DIR``), which every worker of a node shares.
+folder named by the package's sources (``ballenv.physics.base.cache_location``), which every
+worker of a node shares.
 ``warm`` (a function of no arguments) runs first, once on each node, so that the node's workers load
 the compiled kernels from its cache instead of each compiling them at the same time.
 

@@ -6,9 +6,9 @@ paddle mode appends. Everything else is derived from these two tables: the lengt
 clipped to (:func:`bounds`), and the start of each field for the compiled code that writes and reads
 observations (``OBS_*`` and :func:`field_start`: ``row[field_start(OBS_PRESSURE, n)]``).
 
-The ``OBS_*`` constants are frozen into the compiled code of ``batch.py``, whose on-disk numba cache
-is invalidated only by changes to ``batch.py`` itself: after changing a table, clear the
-``__pycache__`` of ``ballenv/envs`` (``tests/envs/test_observation.py`` fails on a stale layout).
+The ``OBS_*`` constants are frozen into the compiled code of ``batch.py``; numba's cache is keyed on
+every source file of the package (``ballenv.physics.base.cache_location``), so a changed table is
+compiled afresh.
 """
 
 from collections.abc import Callable

@@ -1,62 +1,103 @@
-"""Where numba keeps the simulator's compiled kernels.
+"""Where numba keeps the simulator's compiled kernels: a folder named by the source it was built from.
 
-numba caches a kernel beside its source (``__pycache__``) when the package folder is writable. In a
-read-only install it would fall back to its own user-wide folder, or fail with "no locator
-available" where that is not writable either. So, unless ``NUMBA_CACHE_DIR`` is set (which always
-wins), the cache goes to the first writable of: the package folder; ``$XDG_CACHE_HOME/ballenv/numba``
-(by default ``~/.cache/ballenv/numba``, made 0700); none, and then every run compiles. A location
-other than the package folder is said once (:func:`.compile_notice.log_info`). A read-only install
-can ship a populated cache: build it once with ``NUMBA_CACHE_DIR`` pointing into the install and
-set the same ``NUMBA_CACHE_DIR`` when running it.
+numba keys a cached kernel on its own file only: after an edit or an upgrade that changes a function
+in another file (a callee it inlined), the old machine code would still load and run. So the cache
+of ``ballenv`` lives in a folder named by a hash of every source file of the packages that hold
+kernels (``ballenv.physics`` and ``ballenv.envs``), numba's version and Python's
+(:func:`source_key`): different code, a different folder, never a stale kernel, and checkouts of the
+same code share one cache. The folder sits under the first writable of ``NUMBA_CACHE_DIR`` (if set),
+``$XDG_CACHE_HOME/ballenv/numba`` (by default ``~/.cache/ballenv/numba``, 0700) and a private folder
+in the system's temporary directory (said once); with none writable, every run compiles (said once).
+Of the folders under the same parent, the ``KEEP`` most recently used are kept and older ones
+removed. A read-only install can ship its cache: build it with ``NUMBA_CACHE_DIR`` pointing into the
+install, and run with the same setting.
 """
 
+import hashlib
 import os
 import pathlib
+import re
+import shutil
+import sys
 import tempfile
 from collections.abc import Callable
 
+import numba
 from numba.core import config
 
 from .compile_lock import private_dir
 from .compile_notice import log_info
 
-PACKAGE = pathlib.Path(__file__).resolve().parent.parent  # ballenv/physics: the kernels' sources
-MOVED = "the package folder %s is read-only: numba's cache of the simulator goes to %s"
-NONE = "no writable folder for numba's cache (the package folder %s is read-only): every run compiles"
+PACKAGE = pathlib.Path(__file__).resolve().parents[2]  # ballenv/
+KERNEL_PACKAGES = ("physics", "envs")  # where kernels and the constants they freeze are defined
+KEEP = 4  # cache folders of other sources kept under one parent
+KEY = re.compile(r"[0-9a-f]{16}")
+MOVED = "no writable cache folder in %s: numba's cache of the simulator goes to %s"
+NONE = "no writable folder for numba's cache of the simulator: every run compiles"
+
+
+def source_key(package: pathlib.Path = PACKAGE) -> str:
+    """16 hex digits of the SHA-256 of the sources (paths and bytes) of ``KERNEL_PACKAGES``, numba's
+    version and Python's."""
+    digest = hashlib.sha256(f"numba {numba.__version__} python {sys.version_info[:2]}".encode())
+    for path in sorted(p for name in KERNEL_PACKAGES for p in (package / name).rglob("*.py")):
+        digest.update(path.relative_to(package).as_posix().encode() + b"\0" + path.read_bytes() + b"\0")
+    return digest.hexdigest()[:16]
 
 
 def writable(folder: pathlib.Path) -> bool:
-    """Whether a file can be made in ``folder`` (as numba checks it)."""
+    """Whether ``folder`` exists (made if missing) and a file can be made in it (as numba checks)."""
     try:
+        folder.mkdir(mode=0o700, parents=True, exist_ok=True)
         with tempfile.TemporaryFile(dir=folder):
             return True
     except OSError:
         return False
 
 
-def user_folder() -> pathlib.Path:
-    cache = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-    return pathlib.Path(cache) / "ballenv" / "numba"
+def parents() -> list[tuple[pathlib.Path, bool]]:
+    """The candidate parents of the cache folder, in order, each with whether it must be private."""
+    given = os.environ.get("NUMBA_CACHE_DIR")
+    if given:
+        return [(pathlib.Path(given), False)]
+    home = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    user = os.getuid() if hasattr(os, "getuid") else 0
+    temporary = pathlib.Path(tempfile.gettempdir()) / f"ballenv-numba-{user}"
+    return [(pathlib.Path(home) / "ballenv" / "numba", True), (temporary, True)]
 
 
-def choose(
-    package: pathlib.Path = PACKAGE, is_writable: Callable[[pathlib.Path], bool] = writable
-) -> tuple[bool, str]:
-    """``(cache, folder)``: whether to cache, and where (``""``: beside the sources, numba's default)."""
-    given = config.CACHE_DIR  # type: ignore[attr-defined]  # (numba sets its settings at import)
-    if given or is_writable(package):
-        return True, given or ""
-    folder = user_folder()
-    if private_dir(str(folder)) and is_writable(folder):
-        log_info(MOVED, package, folder)
-        return True, str(folder)
-    log_info(NONE, package)
-    return False, ""
+def choose(key: str, is_writable: Callable[[pathlib.Path], bool] = writable) -> str | None:
+    """The cache folder for sources of ``key`` (made), or None if no candidate parent is writable."""
+    candidates = parents()
+    for k, (parent, private) in enumerate(candidates):
+        if private and not private_dir(str(parent)):
+            continue
+        folder = parent / key
+        if is_writable(folder):
+            if k > 0:
+                log_info(MOVED, candidates[0][0], folder)
+            os.utime(folder)
+            prune(parent, folder)
+            return str(folder)
+    log_info(NONE)
+    return None
+
+
+def prune(parent: pathlib.Path, current: pathlib.Path) -> None:
+    """Remove the cache folders under ``parent`` beyond the ``KEEP`` most recently used."""
+    try:
+        others = [p for p in parent.iterdir() if p != current and p.is_dir() and KEY.fullmatch(p.name)]
+    except OSError:
+        return
+    others.sort(key=lambda p: p.stat().st_mtime, reverse=True)
+    for old in others[KEEP:]:
+        shutil.rmtree(old, ignore_errors=True)
 
 
 def apply() -> bool:
-    """Point numba's cache where :func:`choose` says; returns whether kernels are cached."""
-    cache, folder = choose()
-    if folder:
-        config.CACHE_DIR = folder  # type: ignore[attr-defined]
-    return cache
+    """Point numba's cache at the folder of these sources; returns whether kernels are cached."""
+    folder = choose(source_key())
+    if folder is None:
+        return False
+    config.CACHE_DIR = folder  # type: ignore[attr-defined]  # (numba sets its settings at import)
+    return True

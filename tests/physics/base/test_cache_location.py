@@ -1,46 +1,96 @@
-"""Where numba's cache goes: beside the sources, a folder of the user's own in a read-only install,
-or nowhere (every run compiles) where nothing is writable; ``NUMBA_CACHE_DIR`` always wins."""
+"""numba's cache of the simulator: a folder named by the sources, so an edit or an upgrade never
+runs a stale kernel; under the user's cache, a private temporary folder, or nowhere."""
 
 import logging
+import os
 import pathlib
+import shutil
+import subprocess
+import sys
 
 import pytest
-from numba.core import config
 
 from ballenv.physics.base import cache_location
 
 
 @pytest.fixture
-def no_cache_dir(monkeypatch, tmp_path, caplog):
-    monkeypatch.setattr(config, "CACHE_DIR", "")
+def homes(monkeypatch, tmp_path, caplog):
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "home-cache"))
+    monkeypatch.setattr(cache_location.tempfile, "gettempdir", lambda: str(tmp_path / "tmp"))
     caplog.set_level(logging.INFO, logger="ballenv")
     return tmp_path
 
 
-def test_a_writable_install_caches_beside_its_sources(no_cache_dir, caplog):
-    assert cache_location.choose(no_cache_dir, lambda folder: True) == (True, "")
+def test_the_key_changes_with_any_source_file_and_only_with_the_sources(tmp_path):
+    package = tmp_path / "ballenv"
+    shutil.copytree(cache_location.PACKAGE, package, ignore=shutil.ignore_patterns("__pycache__"))
+    key = cache_location.source_key(package)
+    assert key == cache_location.source_key(package) and len(key) == 16
+    (package / "README.txt").write_text("not a source")
+    (package / "viewer.py").write_text("# no kernel here")
+    assert cache_location.source_key(package) == key
+    callee = package / "physics" / "base" / "cyclic.py"  # inlined into kernels of other files
+    callee.write_text(callee.read_text() + "\n# an edit\n")
+    assert cache_location.source_key(package) != key
+
+
+def test_the_cache_goes_under_the_users_cache_named_by_the_key(homes, caplog):
+    folder = pathlib.Path(cache_location.choose("0123456789abcdef"))
+    assert folder == homes / "home-cache" / "ballenv" / "numba" / "0123456789abcdef" and folder.is_dir()
     assert caplog.text == ""
 
 
-def test_a_read_only_install_caches_in_the_users_folder_and_says_so(no_cache_dir, caplog):
-    package = no_cache_dir / "site-packages" / "ballenv" / "physics"
-    cache, folder = cache_location.choose(package, lambda f: f != package and cache_location.writable(f))
-    assert cache and pathlib.Path(folder) == no_cache_dir / "home-cache" / "ballenv" / "numba"
-    assert "is read-only: numba's cache of the simulator goes to" in caplog.text
+def test_numba_cache_dir_is_the_parent_when_set(homes, monkeypatch):
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(homes / "given"))
+    assert cache_location.choose("0123456789abcdef") == str(homes / "given" / "0123456789abcdef")
 
 
-def test_with_nothing_writable_every_run_compiles_and_says_so(no_cache_dir, caplog):
-    assert cache_location.choose(no_cache_dir, lambda folder: False) == (False, "")
+def test_a_read_only_home_falls_back_to_a_private_temporary_folder_and_says_so(homes, caplog):
+    home = homes / "home-cache" / "ballenv" / "numba"
+    folder = cache_location.choose(
+        "0123456789abcdef", lambda f: home not in f.parents and cache_location.writable(f)
+    )
+    assert pathlib.Path(folder).parent.name.startswith("ballenv-numba-")
+    assert "numba's cache of the simulator goes to" in caplog.text
+
+
+def test_with_nothing_writable_every_run_compiles_and_says_so(homes, caplog):
+    assert cache_location.choose("0123456789abcdef", lambda folder: False) is None
     assert "every run compiles" in caplog.text
 
 
-def test_numba_cache_dir_wins(no_cache_dir, monkeypatch, caplog):
-    monkeypatch.setattr(config, "CACHE_DIR", str(no_cache_dir / "given"))
-    assert cache_location.choose(no_cache_dir, lambda folder: False) == (True, str(no_cache_dir / "given"))
-    assert caplog.text == ""
+def test_old_cache_folders_beyond_the_most_recent_few_are_removed(homes):
+    parent = homes / "home-cache" / "ballenv" / "numba"
+    parent.mkdir(parents=True)
+    parent.chmod(0o700)  # as the cache makes it
+    for k in range(7):
+        old = parent / f"{k:016x}"
+        old.mkdir()
+        os.utime(old, (1000 + k, 1000 + k))
+    (parent / "not-a-key").mkdir()
+    cache_location.choose("fedcba9876543210")
+    kept = sorted(p.name for p in parent.iterdir())
+    newest = [f"{k:016x}" for k in (3, 4, 5, 6)]
+    assert kept == sorted([*newest, "fedcba9876543210", "not-a-key"])
 
 
-def test_writable_tells_a_folder_that_takes_files(tmp_path):
-    assert cache_location.writable(tmp_path)
-    assert not cache_location.writable(tmp_path / "missing")
+AREA = """
+import numpy as np
+from ballenv.physics.base.geometry import polygon_area
+print(polygon_area(np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])))
+"""
+
+
+def test_an_edited_callee_in_another_file_is_compiled_again_not_loaded_stale(tmp_path):
+    # numba keys polygon_area's cache on geometry.py alone; next_node (cyclic.py) is inlined into it
+    package = tmp_path / "checkout" / "ballenv"
+    shutil.copytree(cache_location.PACKAGE, package, ignore=shutil.ignore_patterns("__pycache__"))
+    env = dict(os.environ, PYTHONPATH=str(package.parent), NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+    run = [sys.executable, "-c", AREA]
+    first = subprocess.run(run, env=env, capture_output=True, text=True, timeout=300, cwd=tmp_path)
+    assert first.returncode == 0 and float(first.stdout) == 1.0, first.stderr[-2000:]
+    cyclic = package / "physics" / "base" / "cyclic.py"
+    cyclic.write_text(cyclic.read_text().replace("return i + 1 if i < n - 1 else 0", "return i"))
+    second = subprocess.run(run, env=env, capture_output=True, text=True, timeout=300, cwd=tmp_path)
+    assert second.returncode == 0 and float(second.stdout) == 0.0, second.stderr[-2000:]  # the new code
