@@ -14,12 +14,14 @@ before anything is unpickled.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import hmac
 import json
 import os
 import pathlib
 import stat
+import tempfile
 from collections.abc import Iterable
 
 from ballenv.files import write_text
@@ -46,13 +48,15 @@ def key() -> bytes:
     a link, belongs to someone else or others may read it."""
     path = key_path()
     path.parent.mkdir(mode=0o700, parents=True, exist_ok=True)
-    try:
-        fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
-    except FileExistsError:
-        pass
-    else:
-        with os.fdopen(fd, "wb") as f:
-            f.write(os.urandom(KEY_BYTES))
+    if not path.exists():  # made whole, then linked: a process reading it at once sees all of it
+        fd, tmp = tempfile.mkstemp(dir=path.parent)  # 0600
+        try:
+            os.write(fd, os.urandom(KEY_BYTES))
+            os.close(fd)
+            with contextlib.suppress(FileExistsError):  # another process made it first: use theirs
+                os.link(tmp, path)
+        finally:
+            os.unlink(tmp)
     info = os.lstat(path)
     own = not hasattr(os, "getuid") or info.st_uid == os.getuid()
     if stat.S_ISLNK(info.st_mode) or not own or info.st_mode & 0o077:
