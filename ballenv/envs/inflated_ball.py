@@ -11,6 +11,7 @@ from gymnasium import Env, spaces
 from gymnasium.utils import EzPickle
 from numpy.typing import ArrayLike, NDArray
 
+from ..extras import RENDER_NEEDS, render_modes, require_render_mode
 from ..physics.base.ring import total_mass
 from .batch import BallBatch, observation_structure
 from .config import BallEnvConfig, check_reset, draw_reset, failure_message, parse_actions
@@ -141,16 +142,19 @@ class InflatedBallEnv(Env[NDArray[np.float32], NDArray[np.float32]], EzPickle):
     - v0: initial release.
     """
 
-    metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 100.0}  # control_frequency
+    # the modes this installation can draw in (Pillow; pygame-ce for "human"): what checkers try
+    metadata = {"render_modes": render_modes(), "render_fps": 100.0}  # control_frequency
 
     def __init__(self, render_mode: str | None = None, **kwargs: Any) -> None:
         EzPickle.__init__(self, render_mode=render_mode, **kwargs)
         self.config = BallEnvConfig.from_kwargs(kwargs)
-        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+        if render_mode is not None and render_mode not in RENDER_NEEDS:
             raise ValueError(
                 f"InflatedBall-v3.render_mode = {render_mode!r} is out of range: must be None, "
                 "'human' or 'rgb_array'"
             )
+        if render_mode is not None:
+            require_render_mode(render_mode)  # what to install, now rather than at the first frame
         self.render_mode = render_mode
         low, high = self.config.observation_bounds()
         self._batch = BallBatch(self.config.scene(), 1, self.config.task_settings(), low, high)

@@ -20,6 +20,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 from numpy.typing import ArrayLike, NDArray
 
+from ..extras import render_modes
 from .batch import BallBatch, observation_structure
 from .config import BallEnvConfig, check_reset, draw_reset, failure_message, parse_actions
 from .inflated_ball import InflatedBallEnv
@@ -40,7 +41,7 @@ class InflatedBallVectorEnv(VectorEnv[NDArray[np.float32], NDArray[np.float32], 
     env, to the bit, whatever the thread count."""
 
     metadata = {
-        "render_modes": ["rgb_array"],
+        "render_modes": [m for m in render_modes() if m == "rgb_array"],  # Pillow installed
         "render_fps": 100.0,  # control_frequency (set per instance)
         "autoreset_mode": AutoresetMode.NEXT_STEP,
     }

@@ -3,6 +3,8 @@ clear errors (extreme actions: tests/stability/test_env_extreme_actions.py)."""
 
 import copy
 import pickle
+import subprocess
+import sys
 import warnings
 
 import gymnasium as gym
@@ -245,3 +247,37 @@ def test_the_pressure_mode_takes_any_control_rate_the_paddle_one_its_strike():
     gym.make("InflatedBall-v3", control_frequency=500.0).close()  # no strike in this mode
     with pytest.raises(ValueError, match="paddle_strike_duration = 0.003 is out of range"):
         gym.make("InflatedBallPaddle-v3", control_frequency=500.0)
+
+
+WITHOUT_PYGAME = """
+import sys
+
+class Blocker:
+    def find_spec(self, name, path=None, target=None):
+        if name.split(".")[0] == "pygame":
+            raise ModuleNotFoundError("No module named 'pygame' (blocked)", name=name)
+
+sys.meta_path.insert(0, Blocker())
+import gymnasium as gym
+from gymnasium.utils.env_checker import check_env
+import ballenv
+
+env = gym.make("InflatedBall-v3")
+assert env.unwrapped.metadata["render_modes"] == ["rgb_array"], env.unwrapped.metadata
+check_env(env.unwrapped)  # renders every offered mode
+from ballenv.envs.inflated_ball import InflatedBallEnv
+
+try:
+    InflatedBallEnv(render_mode="human")
+except ImportError as err:
+    assert "pygame-ce" in str(err), err
+else:
+    raise AssertionError("human mode without pygame")
+print("ok")
+"""
+
+
+def test_gymnasiums_checker_passes_without_the_window_extra():
+    out = subprocess.run([sys.executable, "-c", WITHOUT_PYGAME], capture_output=True, text=True, timeout=600)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.strip().endswith("ok")
