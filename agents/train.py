@@ -37,7 +37,7 @@ import shutil
 import sys
 import time
 from collections.abc import Callable, Iterator, Mapping, Sequence
-from dataclasses import asdict
+from dataclasses import asdict, dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -358,38 +358,111 @@ def main(argv: Sequence[str] | None = None) -> None:
         sys.exit(130)  # the resumable state is saved (train said where)
 
 
-def train(args: argparse.Namespace, on_evaluation: OnEvaluation | None = None) -> pathlib.Path:
-    """Train, save and score (unless ``args.final_episodes`` is 0); returns the run folder.
-    ``on_evaluation(env steps, mean return)`` sees each periodic evaluation; its False stops the
-    training. If the setup fails (an invalid env keyword, an algorithm that refuses its
-    hyperparameters, ...), the run folder is removed again before the error propagates."""
-    import stable_baselines3
-    import torch
+@dataclass(frozen=True)
+class Plan:
+    """A run's settings: its arguments and hyperparameters (the YAML's, or a resumed run's own) and
+    what follows from them."""
+
+    args: argparse.Namespace
+    hp: dict[str, Any]
+    env_kwargs: dict[str, Any]
+    n_envs: int
+    total: int  # env steps
+    normalize: bool
+    wrapper: str | None
+    algo_kwargs: dict[str, Any]  # as written (config.yml)
+    cls: Any  # the Stable-Baselines3 algorithm
+    model_kwargs: dict[str, Any]  # with RL Zoo's schedules resolved
+    gamma: float
+    demonstrations: Demonstrations | None
+
+
+def plan(args: argparse.Namespace) -> Plan:
+    """The settings of ``args`` (a :class:`UsageError` for a mistaken one, before any folder exists)."""
     from stable_baselines3 import PPO, SAC
-    from stable_baselines3.common.vec_env import VecNormalize
 
     if args.resume:
         args, hp = resumed(args)
     else:
         hp = load_hyperparams(args.algo, args.action_mode, args.conf_file)
         hp.update(args.hyperparams or {})
-    env_kwargs = task_env_kwargs(args.algo, args.action_mode, args.env_kwargs, entry=hp)
-    n_envs = args.n_envs or int(hp.get("n_envs", 1))
-    total = args.total_timesteps or int(hp["n_timesteps"])
-    normalize = bool(hp.get("normalize", True))
     wrapper = hp.get("env_wrapper")
-    algo_kwargs = {k: v for k, v in hp.items() if k not in RUN_KEYS}  # as written (config.yml)
+    algo_kwargs = {k: v for k, v in hp.items() if k not in RUN_KEYS}
     classes: dict[str, type[PPO] | type[SAC]] = {"ppo": PPO, "sac": SAC}
     cls = classes[args.algo]
     check_hyperparams(cls, algo_kwargs)
-    model_kwargs = schedules(algo_kwargs)
     try:
         wrapper_class(wrapper)
     except ValueError as err:
         raise UsageError(str(err)) from None
-    gamma = float(algo_kwargs.get("gamma", 0.99))
-    demonstrations = load_demonstrations(args, wrapper)
+    return Plan(
+        args=args, hp=hp, env_kwargs=task_env_kwargs(args.algo, args.action_mode, args.env_kwargs, entry=hp),
+        n_envs=args.n_envs or int(hp.get("n_envs", 1)), total=args.total_timesteps or int(hp["n_timesteps"]),
+        normalize=bool(hp.get("normalize", True)), wrapper=wrapper, algo_kwargs=algo_kwargs, cls=cls,
+        model_kwargs=schedules(algo_kwargs), gamma=float(algo_kwargs.get("gamma", 0.99)),
+        demonstrations=load_demonstrations(args, wrapper),
+    )  # fmt: skip
 
+
+def run_config(p: Plan) -> dict[str, Any]:
+    """What ``config.yml`` records of the run (what ``--resume`` reads back)."""
+    import stable_baselines3
+    import torch
+
+    a = p.args
+    return {
+        "algo": a.algo, "env_id": env_id(a.action_mode), "env_kwargs": p.env_kwargs, "seed": a.seed,
+        "total_timesteps": p.total, "n_envs": p.n_envs, "normalize": p.normalize,
+        "policy": p.hp.get("policy", "MlpPolicy"), "env_wrapper": p.wrapper,
+        "hyperparams": p.algo_kwargs, "eval_freq": a.eval_freq, "eval_episodes": a.eval_episodes,
+        "vec_env": a.vec_env, "demonstrations": a.demonstrations,
+        "versions": {"stable_baselines3": str(stable_baselines3.__version__),
+                     "torch": str(torch.__version__)},
+    }  # fmt: skip
+
+
+def set_up(run: pathlib.Path, p: Plan, made_log_dir: bool) -> tuple[VecEnv, VecEnv, BaseAlgorithm]:
+    """The run folder's records, the training and evaluation envs and the model (a resumed run's
+    own); a setup that fails removes a new run folder again."""
+    import torch
+
+    a = p.args
+    with removed_on_failure(run, made_log_dir, keep=bool(a.resume)), contextlib.ExitStack() as opened:
+        command = shlex.join([sys.executable, *sys.argv]) + "\n"
+        if a.resume:
+            command = (run / "command.txt").read_text() + command
+        else:
+            write_text(run / "config.yml", yaml.safe_dump(run_config(p), sort_keys=False))
+        write_text(run / "command.txt", command)
+        torch.set_num_threads(1)
+        envs = make_envs(
+            p.env_kwargs, p.n_envs, a.seed, p.normalize, p.gamma, run / "monitor",
+            subproc=a.vec_env == "subproc", wrapper=p.wrapper,
+        )  # fmt: skip
+        opened.callback(envs.close)
+        eval_env = make_envs(
+            p.env_kwargs, 1, a.seed + 1000, p.normalize, p.gamma, training=False, wrapper=p.wrapper
+        )
+        opened.callback(eval_env.close)
+        if a.resume:
+            model = checkpoints.load(run, p.cls, envs)
+        else:
+            model = p.cls(
+                p.hp.get("policy", "MlpPolicy"), envs, seed=a.seed, tensorboard_log=str(run / "tensorboard"),
+                device="cpu", verbose=0, **p.model_kwargs,
+            )  # fmt: skip
+        opened.pop_all()  # set up: the envs stay open for the training
+    return envs, eval_env, model
+
+
+def train(args: argparse.Namespace, on_evaluation: OnEvaluation | None = None) -> pathlib.Path:
+    """Train, save and score (unless ``args.final_episodes`` is 0); returns the run folder.
+    ``on_evaluation(env steps, mean return)`` sees each periodic evaluation; its False stops the
+    training. If the setup fails (an invalid env keyword, an algorithm that refuses its
+    hyperparameters, ...), the run folder is removed again before the error propagates; the first
+    Ctrl-C saves the resumable state (:mod:`agents.checkpoints`) and raises KeyboardInterrupt."""
+    p = plan(args)
+    args = p.args
     made_log_dir = not pathlib.Path(args.log_dir).exists()
     run = (
         pathlib.Path(args.resume)
@@ -397,65 +470,38 @@ def train(args: argparse.Namespace, on_evaluation: OnEvaluation | None = None) -
         else run_folder(args.log_dir, args.algo, args.action_mode, args.seed)
     )
     done = checkpoints.steps_done(run) if args.resume else 0
-    config = {
-        "algo": args.algo, "env_id": env_id(args.action_mode), "env_kwargs": env_kwargs, "seed": args.seed,
-        "total_timesteps": total, "n_envs": n_envs, "normalize": normalize,
-        "policy": hp.get("policy", "MlpPolicy"), "env_wrapper": wrapper,
-        "hyperparams": algo_kwargs, "eval_freq": args.eval_freq, "eval_episodes": args.eval_episodes,
-        "vec_env": args.vec_env, "demonstrations": args.demonstrations,
-        "versions": {"stable_baselines3": str(stable_baselines3.__version__),
-                     "torch": str(torch.__version__)},
-    }  # fmt: skip
-    with removed_on_failure(run, made_log_dir, keep=bool(args.resume)), contextlib.ExitStack() as opened:
-        command = shlex.join([sys.executable, *sys.argv]) + "\n"
-        if args.resume:
-            command = (run / "command.txt").read_text() + command
-        else:
-            write_text(run / "config.yml", yaml.safe_dump(config, sort_keys=False))
-        write_text(run / "command.txt", command)
-        torch.set_num_threads(1)
-        envs = make_envs(
-            env_kwargs, n_envs, args.seed, normalize, gamma, run / "monitor",
-            subproc=args.vec_env == "subproc", wrapper=wrapper,
-        )  # fmt: skip
-        opened.callback(envs.close)
-        eval_env = make_envs(
-            env_kwargs, 1, args.seed + 1000, normalize, gamma, training=False, wrapper=wrapper
-        )
-        opened.callback(eval_env.close)
-        if args.resume:
-            model = checkpoints.load(run, cls, envs)
-        else:
-            model = cls(
-                config["policy"], envs, seed=args.seed, tensorboard_log=str(run / "tensorboard"),
-                device="cpu", verbose=0, **model_kwargs,
-            )  # fmt: skip
-        opened.pop_all()  # set up: the envs stay open for the training
-    if demonstrations is not None:
-        fit = pretrain(model, envs, demonstrations)
+    envs, eval_env, model = set_up(run, p, made_log_dir)
+    if p.demonstrations is not None:
+        fit = pretrain(model, envs, p.demonstrations)
         action, value = fit["action_mse"], fit["value_mse"]
-        print(f"pretrained on {len(demonstrations.actions)} demonstrated bounces: held-back mean "
+        print(f"pretrained on {len(p.demonstrations.actions)} demonstrated bounces: held-back mean "
               f"squared error of the action {action:.2e}, of the value {value:.2e}")  # fmt: skip
     start = time.perf_counter()
-    steps = callbacks(run, eval_env, args, n_envs, total, on_evaluation, demonstrations is not None)
+    steps = callbacks(run, eval_env, args, p.n_envs, p.total, on_evaluation, p.demonstrations is not None)
     with checkpoints.CtrlC() as ctrl_c:
         steps += [checkpoints.every(run, args.checkpoint_minutes), ctrl_c.callback()]
-        model.learn(total_timesteps=total - done, callback=steps, reset_num_timesteps=not args.resume)
+        model.learn(total_timesteps=p.total - done, callback=steps, reset_num_timesteps=not args.resume)
     if ctrl_c.requested:
         interrupted(run, model, envs, eval_env)
     wall = time.perf_counter() - start
-    model.save(run / "model")
-    written = [run / "model.zip"]
-    if isinstance(envs, VecNormalize):  # normalize
-        written.append(save_normalization(envs, run / "vecnormalize.npz"))
-    sign(written)  # this user's training wrote them (agents.signatures): evaluation loads them
-    envs.close()
-    eval_env.close()
+    finish(run, model, envs, eval_env)
     print(f"trained {args.algo} for {model.num_timesteps} env steps in {wall:.0f} s "
           f"({wall / model.num_timesteps * 1e5:.0f} s per 100k steps); run folder {run}")  # fmt: skip
     if args.final_episodes > 0:
-        score(run, args, env_kwargs, wall, model.num_timesteps)
+        score(run, args, p.env_kwargs, wall, model.num_timesteps)
     return run
+
+
+def finish(run: pathlib.Path, model: BaseAlgorithm, envs: VecEnv, eval_env: VecEnv) -> None:
+    """Save the final model and normalisation, signed (:mod:`agents.signatures`: evaluation then
+    loads them), and close the envs."""
+    model.save(run / "model")
+    written = [run / "model.zip"]
+    if hasattr(envs, "obs_rms"):  # a VecNormalize
+        written.append(save_normalization(envs, run / "vecnormalize.npz"))
+    sign(written)
+    envs.close()
+    eval_env.close()
 
 
 def interrupted(run: pathlib.Path, model: BaseAlgorithm, envs: VecEnv, eval_env: VecEnv) -> None:
