@@ -117,6 +117,15 @@ def two_balls(name, speed=20.0, t_end=0.1):
     return Case(name, scene([a, b]), t_end)
 
 
+def collapsed(name, load=50.0, t_end=0.6):
+    """A ring pressed flat by a regulated external pressure (``Scene.gas_exponent`` 0) of ``load``
+    times its buckling load ``p_cr = E h^3 / (4 R^3)`` (20 Pa here), dropped from 0.5 m: it buckles,
+    its walls meet and rest on each other through the self-contact barrier."""
+    r = ring(position=(0.0, 0.5))
+    p_cr = r.youngs_modulus * r.thickness**3 / (4.0 * r.radius**3)
+    return Case(name, scene([replace(r, pressure=-load * p_cr)], gas_exponent=0.0), t_end)
+
+
 def hard_cases():
     """Every named hard case (mass-modification, generalized-alpha; see Case.variant)."""
     return [
@@ -136,4 +145,5 @@ def hard_cases():
         drop("fixed_step_0.01_s", height=1.0, t_end=1.5, scene_kw={"adaptive": False}, pressure=30e3),
         squashed_flat("squashed_flat"),
         two_balls("two_balls_20_m_s"),
+        collapsed("collapsed_by_external_pressure"),
     ]

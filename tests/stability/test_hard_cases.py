@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from ballenv.physics import Ground, Ring, Scene, SimulationError, simulate
+from ballenv.physics.base.geometry import polygon_area
 from ballenv.physics.base.layout import REJECT_NEWTON
 from ballenv.physics.build import build_model, build_workspace, empty_state
 from ballenv.physics.step.integrator import build_solver
@@ -51,6 +52,17 @@ def test_the_cases_are_as_hard_as_named():
     assert v[0] < 0.0 < v[1]  # they met and bounced apart without passing through
     assert CASES["slope_75_deg"].scene.grounds[0].angle == pytest.approx(math.radians(75))
     assert {c.scene.rings[0].n_nodes for c in CASES.values()} >= {8, 512}
+    press = CASES["collapsed_by_external_pressure"]
+    ring = press.scene.rings[0]
+    run = audit(press.scene, press.t_end)
+    np.testing.assert_allclose(run.traj.pressure, ring.pressure, rtol=1e-12)  # the regulator holds it
+    x = run.traj.x[-1, 0]
+    assert polygon_area(x) < 0.1 * math.pi * ring.radius**2  # pressed flat ...
+    n = len(x)
+    apart = np.abs(np.subtract.outer(np.arange(n), np.arange(n)))
+    apart = np.minimum(apart, n - apart) > 3  # wall parts more than 3 edges apart along the ring
+    gaps = np.linalg.norm(x[:, None] - x[None], axis=-1)[apart]
+    assert 0.8 * ring.thickness < gaps.min() < 1.5 * ring.thickness  # ... its walls resting on each other
 
 
 @pytest.mark.parametrize("integrator", INTEGRATORS)

@@ -9,8 +9,13 @@ same code share one cache. The folder sits under the first writable of ``NUMBA_C
 ``$XDG_CACHE_HOME/ballenv/numba`` (by default ``~/.cache/ballenv/numba``, 0700) and a private folder
 in the system's temporary directory (said once); with none writable, every run compiles (said once).
 Of the folders under the same parent, the ``KEEP`` most recently used are kept and older ones
-removed. A read-only install can ship its cache: build it with ``NUMBA_CACHE_DIR`` pointing into the
-install, and run with the same setting.
+removed.
+
+A read-only install can ship its cache: build it with ``NUMBA_CACHE_DIR`` pointing into the install
+(run the kernels once, e.g. the test suite), make it read-only, and run with the same setting. numba
+only uses a cache folder it can write to, so the kernels of a populated read-only folder of these
+sources are copied into the writable folder chosen (said once) and load from there: nothing
+recompiles.
 """
 
 import hashlib
@@ -33,6 +38,7 @@ KERNEL_PACKAGES = ("physics", "envs")  # where kernels and the constants they fr
 KEEP = 4  # cache folders of other sources kept under one parent
 KEY = re.compile(r"[0-9a-f]{16}")
 MOVED = "no writable cache folder in %s: numba's cache of the simulator goes to %s"
+SEEDED = "numba's cache of the simulator in %s is read-only: its kernels are copied to %s"
 NONE = "no writable folder for numba's cache of the simulator: every run compiles"
 
 
@@ -58,17 +64,39 @@ def writable(folder: pathlib.Path) -> bool:
 def parents() -> list[tuple[pathlib.Path, bool]]:
     """The candidate parents of the cache folder, in order, each with whether it must be private."""
     given = os.environ.get("NUMBA_CACHE_DIR")
-    if given:
-        return [(pathlib.Path(given), False)]
     home = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
     user = os.getuid() if hasattr(os, "getuid") else 0
     temporary = pathlib.Path(tempfile.gettempdir()) / f"ballenv-numba-{user}"
-    return [(pathlib.Path(home) / "ballenv" / "numba", True), (temporary, True)]
+    own = [(pathlib.Path(home) / "ballenv" / "numba", True), (temporary, True)]
+    return [(pathlib.Path(given), False), *own] if given else own
+
+
+def populated(folder: pathlib.Path) -> bool:
+    """Whether ``folder`` holds numba cache indexes (``*.nbi``) of compiled kernels."""
+    try:
+        return any(folder.rglob("*.nbi"))
+    except OSError:
+        return False
+
+
+def seed(folder: pathlib.Path, source: pathlib.Path) -> None:
+    """Copy the cache files of ``source`` (a read-only cache folder of the same sources) that
+    ``folder`` lacks into it; a file that cannot be copied is left to compile."""
+    for path in source.rglob("*"):
+        target = folder / path.relative_to(source)
+        try:
+            if path.is_dir():
+                target.mkdir(mode=0o700, parents=True, exist_ok=True)
+            elif not target.exists():
+                shutil.copyfile(path, target)
+        except OSError:
+            continue
 
 
 def choose(key: str, is_writable: Callable[[pathlib.Path], bool] = writable) -> str | None:
     """The cache folder for sources of ``key`` (made), or None if no candidate parent is writable."""
     candidates = parents()
+    shipped = None  # a populated read-only folder of these sources
     for k, (parent, private) in enumerate(candidates):
         if private and not private_dir(str(parent)):
             continue
@@ -76,9 +104,14 @@ def choose(key: str, is_writable: Callable[[pathlib.Path], bool] = writable) -> 
         if is_writable(folder):
             if k > 0:
                 log_info(MOVED, candidates[0][0], folder)
+            if shipped is not None:
+                log_info(SEEDED, shipped, folder)
+                seed(folder, shipped)
             os.utime(folder)
             prune(parent, folder)
             return str(folder)
+        if shipped is None and populated(folder):
+            shipped = folder
     log_info(NONE)
     return None
 

@@ -99,12 +99,14 @@ CLOCK_BOUNDARY_WORK = CLOCK.index("boundary_work")
 N_CLOCK = CLOCK.size
 
 # columns of State.energy (J): a ring's energy, its free part (kinetic plus elastic and gas energy
-# above the inflated circle at rest, gravity left out) and its energy budget (the energy at the
-# start plus what actuation, collision impulses and moving grounds gave it since)
-ENERGY = Layout("total", "free", "budget")
+# above the inflated circle at rest, gravity left out), its energy budget (the energy at the
+# start plus what actuation, collision impulses and moving grounds gave it since) and its kinetic
+# energy
+ENERGY = Layout("total", "free", "budget", "kinetic")
 ENERGY_TOTAL = ENERGY.index("total")
 ENERGY_FREE = ENERGY.index("free")
 ENERGY_BUDGET = ENERGY.index("budget")
+ENERGY_MOTION = ENERGY.index("kinetic")
 
 # Workspace.energy_tally of a trial step: rings whose energy the budget lowered, the energy it
 # removed (J), the net energy the step's collision impulses created (J; 0 if they removed energy),

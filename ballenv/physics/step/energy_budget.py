@@ -16,6 +16,7 @@ from ..base.jit import kernel
 from ..base.layout import (
     ENERGY_BUDGET,
     ENERGY_FREE,
+    ENERGY_MOTION,
     ENERGY_TOTAL,
     GROUND_PLANE,
     SURFACE_KIND,
@@ -27,7 +28,7 @@ from ..base.layout import (
     TALLY_PROJECTED,
     TALLY_REMOVED,
 )
-from ..effects.assembly import gravity_column, ring_energy
+from ..effects.assembly import ENERGY_KINETIC, gravity_column, ring_energy
 from ..ground.contact import FREE, rest_on_grounds
 from ..walls.self_barrier import barrier_energy, find_pairs, near_pairs, reach, stiffness
 from ..walls.wall_limits import wall_limit_energy
@@ -40,14 +41,16 @@ WORK_ERROR_TOL = 0.1  # largest unpayable excess of a step on a moving ground, r
 def free_energy(model, r, x, v, ws, out):
     """``out[ENERGY_TOTAL]`` = the energy (J) of ring ``r``; ``out[ENERGY_FREE]`` = its free part:
     kinetic plus elastic, gas and self-contact barrier energy (:func:`walls.self_barrier.barrier_energy`)
-    above the inflated circle at rest (``Model.rest_energy``), gravity left out. The effects' parts
-    are left in ``ws.energy``; other columns of ``out`` are left alone."""
+    above the inflated circle at rest (``Model.rest_energy``), gravity left out;
+    ``out[ENERGY_MOTION]`` = its kinetic energy. The effects' parts are left in ``ws.energy``; the
+    budget column of ``out`` is left alone."""
     parts = ws.energy
     out[ENERGY_TOTAL] = ring_energy(model, r, x, v, parts)
     if model.self_barrier:
         out[ENERGY_TOTAL] += self_contact_energy(model, r, x, ws.barrier)
     g = gravity_column(model)
     out[ENERGY_FREE] = out[ENERGY_TOTAL] - (parts[g] if g >= 0 else 0.0) - model.rest_energy[r]
+    out[ENERGY_MOTION] = parts[ENERGY_KINETIC]
 
 
 @kernel(inline="always")
@@ -118,11 +121,21 @@ def self_contact_energy(model, r, x, bw):
     return limits + barrier_energy(x, bw.pairs, count, stiffness(model, r), reach(model, r))
 
 
+@kernel(inline="always")
+def exchanged_energy(row):
+    """The energy (J) a ring with carried energy ``row`` (columns ``base.layout.ENERGY``) moves
+    between its parts: its free energy, or its kinetic energy where that is more. The two agree
+    wherever the inflated circle at rest is the ring's least energy (free >= kinetic); a ring whose
+    circle is unstable (pressed by a regulated external pressure above its buckling load) turns
+    the pressure's work into motion while its free energy stays near 0 or falls below it."""
+    return max(row[ENERGY_FREE], row[ENERGY_MOTION])
+
+
 @kernel
 def energy_grew(total_before, free_before, total_after, free_after):
-    """True if a step from energy ``total_before`` to ``total_after`` (J; ``free_``: their free
-    parts, see :func:`free_energy`) raised the total by more than ``ENERGY_GROWTH_TOL`` times the
-    mean free energy, or gave a non-finite energy."""
+    """True if a step from energy ``total_before`` to ``total_after`` (J; ``free_``: the energy each
+    moves between its parts, :func:`exchanged_energy`) raised the total by more than
+    ``ENERGY_GROWTH_TOL`` times their mean, or gave a non-finite energy."""
     if not math.isfinite(total_after):
         return True
     free = max(0.5 * (free_before + free_after), 0.0)
@@ -156,7 +169,8 @@ def within_energy_budget(model, r, before, kick, work, trial, ws):
     kinetic energy of its collision impulses plus the moving grounds' work ``work`` (J,
     :func:`boundary_work`).
 
-    A gain of the step above ``ENERGY_GROWTH_TOL`` times the mean free energy is a spurious solution
+    A gain of the step above ``ENERGY_GROWTH_TOL`` times the mean energy it exchanges
+    (:func:`exchanged_energy`) is a spurious solution
     (far too large implicit steps of a nonlinear ring converge to some): returns False, the step is
     rejected and retried smaller. Smaller gains are the integrator's truncation error
     (generalized-alpha is not energy-stable for a nonlinear ring: the energy of a spinning ring
@@ -177,7 +191,10 @@ def within_energy_budget(model, r, before, kick, work, trial, ws):
     hold the energy parts of the trial state (as :func:`free_energy` leaves them)."""
     after = trial.energy[r]
     if energy_grew(
-        before[ENERGY_TOTAL] + kick, before[ENERGY_FREE] + kick, after[ENERGY_TOTAL], after[ENERGY_FREE]
+        before[ENERGY_TOTAL] + kick,
+        exchanged_energy(before) + kick,
+        after[ENERGY_TOTAL],
+        exchanged_energy(after),
     ):
         return False
     excess = after[ENERGY_TOTAL] - after[ENERGY_BUDGET]

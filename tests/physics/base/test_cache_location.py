@@ -94,3 +94,49 @@ def test_an_edited_callee_in_another_file_is_compiled_again_not_loaded_stale(tmp
     cyclic.write_text(cyclic.read_text().replace("return i + 1 if i < n - 1 else 0", "return i"))
     second = subprocess.run(run, env=env, capture_output=True, text=True, timeout=300, cwd=tmp_path)
     assert second.returncode == 0 and float(second.stdout) == 0.0, second.stderr[-2000:]  # the new code
+
+
+def test_a_populated_read_only_cache_is_copied_to_the_writable_folder(homes, caplog):
+    shipped = homes / "install" / "0123456789abcdef"
+    (shipped / "physics").mkdir(parents=True)
+    (shipped / "physics" / "geometry.polygon_area-9.py311.nbi").write_bytes(b"index")
+    (shipped / "physics" / "geometry.polygon_area-9.py311.1.nbc").write_bytes(b"code")
+    os.environ["NUMBA_CACHE_DIR"] = str(homes / "install")
+    try:
+        folder = cache_location.choose(
+            "0123456789abcdef", lambda f: shipped not in (f, *f.parents) and cache_location.writable(f)
+        )
+    finally:
+        del os.environ["NUMBA_CACHE_DIR"]
+    folder = pathlib.Path(folder)
+    assert folder == homes / "home-cache" / "ballenv" / "numba" / "0123456789abcdef"
+    assert (folder / "physics" / "geometry.polygon_area-9.py311.1.nbc").read_bytes() == b"code"
+    assert "is read-only: its kernels are copied to" in caplog.text
+
+
+READ_ONLY = """
+import pathlib, sys
+import numpy as np
+from ballenv.physics.base import cache_location, jit
+from ballenv.physics.base.geometry import polygon_area
+shipped = pathlib.Path(sys.argv[1])  # taken as read-only whoever runs this (root writes anywhere)
+writable = cache_location.writable
+cache_location.choose.__defaults__ = (lambda f: shipped not in (f, *f.parents) and writable(f),)
+assert cache_location.apply()
+print(polygon_area(np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])))
+print(len(jit.python_entry(polygon_area).stats.cache_hits))
+"""
+
+
+def test_a_read_only_install_runs_its_shipped_kernels_without_compiling(tmp_path):
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "install"), XDG_CACHE_HOME=str(tmp_path / "home"))
+    build = subprocess.run([sys.executable, "-c", AREA], env=env, capture_output=True, text=True, timeout=300)
+    assert build.returncode == 0 and "compiled polygon_area" in build.stderr, build.stderr[-2000:]
+    shipped = tmp_path / "install" / cache_location.source_key()
+    run = [sys.executable, "-c", READ_ONLY, str(shipped)]
+    second = subprocess.run(run, env=env, capture_output=True, text=True, timeout=300)
+    assert second.returncode == 0, second.stderr[-2000:]
+    assert second.stdout.split() == ["1.0", "1"]  # the area, loaded from the cache (one hit)
+    assert "is read-only: its kernels are copied to" in second.stderr
+    assert "compiling" not in second.stderr
+    assert (tmp_path / "home" / "ballenv" / "numba" / shipped.name).is_dir()
