@@ -5,9 +5,11 @@ Python blocks run, in order, in one namespace per file (a later block may use an
 names), in a temporary folder. Each command of a shell block is checked without running it:
 ``make X`` is a target of the Makefile (``make -n``); ``python train.py`` and ``python -m
 agents.evaluate`` / ``study`` / ``tune`` / ``imitation`` parse with those modules' own argument parsers; ``pip
-install`` names a constraints file and extras that exist. A block of another language, or a
-command no check knows, fails: a new block needs a check here, or an entry in ``EXEMPT`` with
-the reason.
+install`` installs this checkout (``-e .[EXTRAS]``, extras that exist) with a constraints file that
+exists, and takes packages from no index but PyPI and PyTorch's CPU-only one. A block of another
+language, or a command no check knows, fails: a new block needs a check here, or an entry in
+``EXEMPT`` with the reason. The Guide's pages of commands only (``SHELL_DOCUMENTS``) are checked
+the same way.
 """
 
 import re
@@ -18,7 +20,9 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-DOCUMENTS = ("README.md", "docs/quickstart.md", "docs/balls.md")
+DOCUMENTS = ("README.md", "docs/quickstart.md", "docs/balls.md")  # Python blocks that run, and commands
+SHELL_DOCUMENTS = ("docs/training.md", "benchmarks/results/agents_v3.md")  # commands only
+TORCH_CPU_INDEX = "https://download.pytorch.org/whl/cpu"  # PyTorch's index of its CPU-only builds
 PYTHON = {"python", "py"}
 SHELL = {"bash", "sh", "shell"}
 EXEMPT = {  # command -> why it is not checked
@@ -37,7 +41,7 @@ def code_blocks(name):
 def shell_blocks():
     return [
         pytest.param(name, line, code, id=f"{name}:{line}")
-        for name in DOCUMENTS
+        for name in DOCUMENTS + SHELL_DOCUMENTS
         for language, line, code in code_blocks(name)
         if language in SHELL
     ]
@@ -92,16 +96,32 @@ def pyproject_extras():
 
 def check_pip_install(args):
     options, values = args[::2], args[1::2]
-    known = len(options) == len(values) and set(options) <= {"-c", "-e"}
-    assert known, f"pip install {shlex.join(args)}: the check knows only -c FILE and -e .[EXTRAS]"
+    known = len(options) == len(values) and set(options) <= {"-c", "-e", "--extra-index-url"}
+    only = "-c FILE, -e .[EXTRAS] and --extra-index-url URL"
+    assert known, f"pip install {shlex.join(args)}: the check knows only {only}"
+    assert "-e" in options, f"pip install {shlex.join(args)}: installs no checkout (ballenv is not on PyPI)"
     for option, value in zip(options, values, strict=True):
         if option == "-c":
             assert (ROOT / value).is_file(), f"pip install -c {value}: no such file"
+        elif option == "--extra-index-url":
+            assert value == TORCH_CPU_INDEX, f"pip install --extra-index-url {value}: only {TORCH_CPU_INDEX}"
         else:
             named = re.fullmatch(r"\.(?:\[([\w,-]+)\])?", value)
             assert named, f"pip install -e {value}: not this checkout (.[extras])"
             missing = set((named.group(1) or "").split(",")) - pyproject_extras() - {""}
             assert not missing, f"pip install -e {value}: no extra {sorted(missing)} in pyproject.toml"
+
+
+def test_the_cpu_index_is_where_torch_meets_its_constraint():
+    # the CPU-only builds are torch==X+cpu, which the constraint torch==X admits (PEP 440: a local
+    # version label is ignored by a specifier without one)
+    from packaging.specifiers import SpecifierSet
+
+    pins = dict(
+        line.split("==", 1) for line in (ROOT / "constraints.txt").read_text().splitlines() if "==" in line
+    )
+    assert "torch" in pins, "constraints.txt pins no torch"
+    assert f"{pins['torch']}+cpu" in SpecifierSet(f"=={pins['torch']}")
 
 
 def checker(argv):
@@ -124,7 +144,7 @@ def checker(argv):
     return None, argv
 
 
-@pytest.mark.parametrize("name", DOCUMENTS)
+@pytest.mark.parametrize("name", DOCUMENTS + SHELL_DOCUMENTS)
 def test_every_block_is_python_or_shell(name):
     blocks = code_blocks(name)
     assert blocks, f"{name}: no code block found"
@@ -182,4 +202,13 @@ def test_a_wrong_command_line_fails_its_check():
         check(args)
     check, args = checker(shlex.split("pip install ballenv"))
     with pytest.raises(AssertionError, match="knows only"):
+        check(args)
+    check, args = checker(shlex.split("pip install -c constraints.txt 'ballenv[train]'"))
+    with pytest.raises(AssertionError, match="knows only"):
+        check(args)
+    check, args = checker(shlex.split("pip install -c constraints.txt"))
+    with pytest.raises(AssertionError, match="installs no checkout"):
+        check(args)
+    check, args = checker(shlex.split("pip install -e . --extra-index-url https://example.org/simple"))
+    with pytest.raises(AssertionError, match="only https://download.pytorch.org/whl/cpu"):
         check(args)

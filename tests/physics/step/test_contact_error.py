@@ -135,7 +135,7 @@ def test_error_falls_with_the_tolerance_on_the_family(control, name, at_most):
     Under "doubling", the light ring on a slope and the heavy ball with friction (the family:
     0.06-3.5 ``rtol``, ``accuracy.py``); under "impulse" (the default), the three balls on which one
     drop's error falls at every tightening (0.004-0.22 ``rtol``; on the bending, stiff and
-    light rings it rises once, within the error's scatter from drop to drop: docs/benchmarks.md)."""
+    light rings it rises once, within the error's scatter from drop to drop: docs/notes/benchmarks.md)."""
     tolerances = (3e-2, 1e-2, 3e-3, 1e-3)
     errors = _family_errors(name, tolerances, control)
     assert all(b < a for a, b in zip(errors, errors[1:], strict=False)), errors
