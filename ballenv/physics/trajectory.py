@@ -254,6 +254,8 @@ def _write_archive(
 UNREADABLE = (
     OSError, EOFError, zipfile.BadZipFile, zlib.error, KeyError, TypeError, IndexError,
     RecursionError, UnicodeDecodeError, OverflowError, struct.error,
+    NotImplementedError,  # zipfile: a member's compression method it does not know
+    RuntimeError,  # zipfile: a member flagged as encrypted
 )  # fmt: skip
 
 

@@ -159,12 +159,18 @@ def test_every_malformed_field_is_one_value_error_naming_the_file(traj, tmp_path
     assert str(path) in str(err.value)
 
 
-@pytest.mark.parametrize("damage", ["truncated", "corrupt deflate", "bad crc"])
+@pytest.mark.parametrize("damage", ["truncated", "corrupt deflate", "bad crc", "encrypted", "compression 99"])
 def test_a_damaged_archive_is_a_value_error_not_a_zlib_or_zip_error(traj, tmp_path, damage):
     path = traj.save(tmp_path / "damaged.npz")
     data = bytearray(path.read_bytes())
     if damage == "truncated":
         data = data[: len(data) // 2]
+    elif damage in ("encrypted", "compression 99"):  # the central directory's entry of the first member
+        entry = data.index(b"PK\x01\x02")
+        if damage == "encrypted":
+            data[entry + 8] |= 1  # general purpose flag, bit 0 (zipfile: RuntimeError)
+        else:
+            data[entry + 10 : entry + 12] = (99).to_bytes(2, "little")  # (zipfile: NotImplementedError)
     else:
         with zipfile.ZipFile(path) as archive:
             info = archive.getinfo("x.npy")
