@@ -100,7 +100,10 @@ class Simulation:
         x0, v0: optional initial node positions (m) and velocities (m/s), shape (n_rings, n_nodes, 2)
             (or (n_nodes, 2) for one ring). The contact barriers' stiffness follows the scene's own
             start (``Ring.velocity``, ``angular_velocity``: ``Model.start_energy``), also with these.
-        output_dt: record interval (s); None records every accepted step.
+        output_dt: record interval (s): records at its multiples (and at the end), interpolated within
+            the accepted steps (``step/dense_output.py``: cubic Hermite, exact on a flight
+            parabola), so recording neither shortens steps nor changes the run; None records
+            every accepted step (the solver's own states).
         expected_end: the time (s) the run is expected to reach, to size the recording (it grows).
         effects: the force effects summed on each ring: the registry ``ballenv.physics.effects.EFFECTS``
             by default, or another list of effect modules (e.g. the registry plus a new force).
@@ -514,7 +517,10 @@ def simulate(
             (or (n_nodes, 2) for one ring); default: the rings' circles and rigid motions. Each ring
             of ``x0`` must be a simple polygon with its nodes counter-clockwise and no two
             neighbours at the same place (ValueError otherwise, before anything is compiled).
-        output_dt: record interval (s); None records every accepted step.
+        output_dt: record interval (s): records at its multiples (and at the end), interpolated within
+            the accepted steps (``step/dense_output.py``: cubic Hermite, exact on a flight
+            parabola), so recording neither shortens steps nor changes the run; None records
+            every accepted step (the solver's own states).
         progress: show a progress bar (tqdm) over simulated time.
 
     Returns:

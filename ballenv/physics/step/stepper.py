@@ -1,14 +1,15 @@
 """The time step of a scene: one trial step of every ring, its acceptance, and the step size.
 
 :func:`advance` repeats :func:`try_step` until a time, in phases: the step's end (:func:`step_end`:
-the step size, output times, the fixed grid, actuation windows and, under error control, a ring's
+the step size, the fixed grid, actuation windows and, under error control, a ring's
 first touch of a ground: :mod:`ballenv.physics.ground.touchdown`), the actuation the step delivers
 (:mod:`ballenv.physics.step.actuation`: its share of a gas ramp or a spread impulse; nothing without them),
 the trial step of every ring (collision impulses, Newton's iteration with the contact set,
 :mod:`ballenv.physics.step.newton`), the
 acceptance tests (Newton failure, self-intersection, energy budget, ring intrusion, contact
 impulse), then the bookkeeping of a rejected (:func:`step_outcome`) or an accepted step
-(:func:`accept`, the end of a gas ramp, events, records) and the next step size. Counters, clock
+(:func:`accept`, the end of a gas ramp, events, records, interpolated within the step at output
+times: :mod:`ballenv.physics.step.dense_output`) and the next step size. Counters, clock
 and energy columns are the named layouts of :mod:`ballenv.physics.base.layout`.
 """
 
@@ -59,6 +60,7 @@ from ..model import CONTACT_NONE
 from ..walls.impulses import collision_impulses, collision_step_limit, rings_intrude, self_intersects
 from .actuation import drive_landing, drive_step
 from .contact_error import arrival_norm, doubling_norm, in_contact
+from .dense_output import outputs_within, record_within
 from .energy_budget import boundary_work, free_energy, within_energy_budget
 from .events import detect_events
 from .integrator import arrival_factor, carries_acceleration, error_exponent, time_tolerance
@@ -418,31 +420,40 @@ def copy_state(state, trial):
 
 
 @kernel(inline="always")
-def step_end(solver, clock, counters, t_end, output_dt, landing):
-    """The end of the next step: ``(stop, at_end, at_out, at_grid)``: the time (s) the step from
-    ``clock[CLOCK_T]`` with size ``clock[CLOCK_H]`` stops at, shortened to land on the next output
-    time (``output_dt`` > 0), the fixed grid (not adaptive), the ``landing`` time (s; inf for none:
-    the first of an actuation's window, :func:`step.actuation.drive_landing`, and a ring's first touch,
-    :func:`ground.touchdown.touchdown_landing`) and ``t_end``, and which it landed on."""
+def step_end(solver, clock, counters, t_end, landing):
+    """The end of the next step: ``(stop, at_end, at_grid)``: the time (s) the step from
+    ``clock[CLOCK_T]`` with size ``clock[CLOCK_H]`` stops at, shortened to land on the fixed grid
+    (not adaptive), the ``landing`` time (s; inf for none: the first of an actuation's window,
+    :func:`step.actuation.drive_landing`, and a ring's first touch,
+    :func:`ground.touchdown.touchdown_landing`) and ``t_end``, and which it landed on. Output times
+    do not shorten steps (:mod:`ballenv.physics.step.dense_output`)."""
     t = clock[CLOCK_T]
     eps = time_tolerance(solver)
     stop = min(t + clock[CLOCK_H], landing)
-    next_out = t_end
-    if output_dt > 0.0:
-        next_out = (math.floor((t + eps) / output_dt) + 1.0) * output_dt
-        stop = min(stop, next_out)
     grid = (counters[COUNT_GRID] + 1) * solver.dt
     if not solver.adaptive:
         stop = min(stop, grid)
     stop = min(stop, t_end)
     at_end = stop >= t_end - eps
-    at_out = output_dt > 0.0 and abs(stop - next_out) <= eps
     at_grid = not solver.adaptive and abs(stop - grid) <= eps
     if at_grid:  # on the grid itself: a clock summing steps of a non-binary dt drifts off it
         stop = grid
     if at_end:
         stop = t_end
-    return stop, at_end, at_out, at_grid
+    return stop, at_end, at_grid
+
+
+@kernel(inline="always")
+def records_needed(t, stop, output_dt, eps):
+    """Records a step from ``t`` to ``stop`` (s) may write: its end and, with ``output_dt`` > 0,
+    the output times inside it (:func:`dense_output.outputs_within`)."""
+    return 1 + (outputs_within(t, stop, output_dt, eps) if output_dt > 0.0 else 0)
+
+
+@kernel(inline="always")
+def on_output(t, output_dt, eps):
+    """Whether ``t`` (s) is an output time ``k output_dt`` (within ``eps``)."""
+    return abs(t - output_dt * round(t / output_dt)) <= eps
 
 
 @kernel(inline="always")
@@ -503,8 +514,9 @@ def advance(model, solver, ws, state, trial, clock, counters, t_pause, t_end, ou
     that reaches ``t_pause`` (<= ``t_end``; for progress reports).
 
     Records into ``rec`` from index ``counters[COUNT_RECORDS]`` on: every accepted step if
-    ``output_dt == 0``, else exactly at multiples of ``output_dt`` (steps are shortened to land on
-    them); events go to ``rec.events`` rows (t, ring, kind, centre-of-mass height). Returns
+    ``output_dt == 0``, else at multiples of ``output_dt`` and ``t_end``, interpolated within the
+    accepted steps (:mod:`ballenv.physics.step.dense_output`: the steps are those of a run without
+    records); events go to ``rec.events`` rows (t, ring, kind, centre-of-mass height). Returns
     STATUS_DONE, STATUS_BUFFER_FULL (call again with room), STATUS_STEP_TOO_SMALL (rejected steps
     halved the step below ``dt_min``; ``counters[COUNT_REJECTION]`` says why the last one was) or
     STATUS_IMPULSE_AT_DT_MIN (the contact impulse exceeds ``impulse_tol`` even at ``dt_min``); on
@@ -529,8 +541,9 @@ def advance(model, solver, ws, state, trial, clock, counters, t_pause, t_end, ou
     """
     capacity = rec.t.shape[0]
     n_rings = state.x.shape[0]
+    eps = time_tolerance(solver)
     while clock[CLOCK_T] < t_pause:
-        if counters[COUNT_RECORDS] >= capacity or counters[COUNT_EVENTS] + 3 * n_rings > rec.events.shape[0]:
+        if counters[COUNT_EVENTS] + 3 * n_rings > rec.events.shape[0]:
             return STATUS_BUFFER_FULL
         if model.collide:
             limit = collision_step_limit(state.x, state.v, model.thickness, clock[CLOCK_H], ws.ring_pairs)
@@ -538,7 +551,9 @@ def advance(model, solver, ws, state, trial, clock, counters, t_pause, t_end, ou
         landing = touchdown_landing(model, solver, ws, state, clock[CLOCK_T], clock[CLOCK_H])
         if drive is not None:  # (pruned by numba for a drive of None: no code)
             landing = min(landing, drive_landing(solver, clock[CLOCK_T], drive))
-        stop, at_end, at_out, at_grid = step_end(solver, clock, counters, t_end, output_dt, landing)
+        stop, at_end, at_grid = step_end(solver, clock, counters, t_end, landing)
+        if counters[COUNT_RECORDS] + records_needed(clock[CLOCK_T], stop, output_dt, eps) > capacity:
+            return STATUS_BUFFER_FULL
         if drive is not None:
             drive_step(model, solver, state, clock[CLOCK_T], stop, ws, drive)
         h = stop - clock[CLOCK_T]
@@ -553,10 +568,14 @@ def advance(model, solver, ws, state, trial, clock, counters, t_pause, t_end, ou
             continue
         if status != STATUS_DONE:
             return status
+        if output_dt > 0.0:
+            counters[COUNT_RECORDS] = record_within(
+                model, state, trial, clock[CLOCK_T], h, output_dt, eps, rec, counters[COUNT_RECORDS]
+            )
         accept(model, solver, ws, state, trial, clock, counters, h, stop, at_grid, ratio, rec)
         if drive is not None:
             drive_step(model, solver, state, stop, stop, ws, drive)  # a ramp ending here: its end amount
-        if output_dt == 0.0 or at_out or at_end:
+        if output_dt == 0.0 or at_end or on_output(stop, output_dt, eps):
             record(model, counters[COUNT_RECORDS], stop, state, rec)
             counters[COUNT_RECORDS] += 1
     return STATUS_DONE

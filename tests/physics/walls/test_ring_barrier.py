@@ -205,12 +205,12 @@ def five_balls(mode, impulse_tol=2e-3):
 
 def test_five_balls_stacked_in_a_narrow_box_settle():
     scene = five_balls("barrier")
-    traj = simulate(scene, 3.0, output_dt=0.01)
+    traj = simulate(scene, 3.0)  # every step: the solver's states, not interpolated records
     kinetic = traj.energy()["kinetic"].sum(axis=1)
     assert kinetic.max() > 1e-2  # they fell and hit each other (measured 0.018 J)
     # no jiggle over the last 0.5 s: measured 1.7e-6 J, still decaying (1e-7 J at 4 s); the explicit
     # impulses ("reject") keep these balls jiggling at 8e-3 J
-    assert kinetic[-50:].max() < 1e-5
+    assert kinetic[traj.t > 2.5].max() < 1e-5
     assert closest(scene, traj) > 0.9  # resting at the contact distance (measured 0.96)
     assert no_intrusion(traj.x, np.full(5, scene.rings[0].thickness))
     centres = traj.centre_of_mass()[-1]
