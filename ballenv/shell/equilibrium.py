@@ -113,15 +113,21 @@ def free_mask(
 
 
 def newton_direction(
-    problem: Problem, x: NDArray[np.float64], grad: NDArray[np.float64]
+    problem: Problem,
+    x: NDArray[np.float64],
+    grad: NDArray[np.float64],
+    base: NDArray[np.float64] | None = None,
 ) -> NDArray[np.float64]:
-    """The Newton correction ``dx`` (m) at ``x`` with gradient ``grad`` (module doc)."""
+    """The Newton correction ``dx`` (m) at ``x`` with gradient ``grad`` (module doc); ``base``
+    (V, 3), a diagonal added to the Hessian (N/m: a mass term, a barrier's curvature), or None."""
     m, ws, env = problem.model, problem.ws, problem.env
     s = potential.hessian(m, ws, x)
     diagonal = np.zeros_like(x)
     mean = np.mean([np.abs(np.diagonal(ws.tri_hess, axis1=1, axis2=2)).mean(), m.kb])
     for tau in SHIFTS:
         diagonal[:] = tau * mean
+        if base is not None:
+            diagonal += base
         envelope.assemble(env, m.triangles, ws.tri_hess, m.hinges, ws.hinge_hess, diagonal, problem.free)
         if envelope.cholesky(env):
             dx = np.zeros_like(x)
