@@ -22,6 +22,7 @@ PHYSICS_LAYERS = (
 PACKAGE_LAYERS = (
     ("ballenv.extras", "ballenv.files", "ballenv.draw", "ballenv.video"),
     ("ballenv.physics",),
+    ("ballenv.shell",),
     ("ballenv.balls", "ballenv.controllers", "ballenv.cluster", "ballenv.envs"),
     ("ballenv.viewer", "ballenv.scenes", "ballenv.clips", "ballenv.demo", "ballenv"),
     ("agents",),

@@ -24,7 +24,8 @@ DEFAULT_RTOL = 1e-2  # the adaptive step's relative tolerance when a Scene names
 T = TypeVar("T")
 
 
-def _fail(owner: str, name: str, value: object, valid: str) -> NoReturn:
+def fail(owner: str, name: str, value: object, valid: str) -> NoReturn:
+    """Raise the ValueError of parameter ``owner.name`` out of range: its value and ``valid``."""
     raise ValueError(f"{owner}.{name} = {value!r} is out of range: must be {valid}")
 
 
@@ -43,19 +44,19 @@ def check_real(
     hi_br = ")" if high_open else "]"
     valid = f"a finite number in {lo_br}{low:g}, {high:g}{hi_br}" + (f" {unit}" if unit else "")
     if isinstance(value, bool) or not isinstance(value, Real):
-        _fail(owner, name, value, valid)
+        fail(owner, name, value, valid)
     v = float(value)
     if not math.isfinite(v):
-        _fail(owner, name, value, valid)
+        fail(owner, name, value, valid)
     if v < low or v > high or (low_open and v == low) or (high_open and v == high):
-        _fail(owner, name, value, valid)
+        fail(owner, name, value, valid)
     return v
 
 
 def check_int(owner: str, name: str, value: object, low: int, high: int) -> int:
     """Return ``value`` as int if it is an integer within [low, high], else raise ValueError."""
     if isinstance(value, bool) or not isinstance(value, Integral) or not low <= int(value) <= high:
-        _fail(owner, name, value, f"an integer in [{low}, {high}]")
+        fail(owner, name, value, f"an integer in [{low}, {high}]")
     return int(value)
 
 
@@ -65,16 +66,16 @@ def check_vector(owner: str, name: str, value: Any, bound: float, unit: str) -> 
     try:
         items = tuple(value)
     except TypeError:
-        _fail(owner, name, value, valid)
+        fail(owner, name, value, valid)
     if len(items) != 2:
-        _fail(owner, name, value, valid)
+        fail(owner, name, value, valid)
     out = []
     for item in items:
         if isinstance(item, bool) or not isinstance(item, Real):
-            _fail(owner, name, value, valid)
+            fail(owner, name, value, valid)
         f = float(item)
         if not math.isfinite(f) or abs(f) > bound:
-            _fail(owner, name, value, valid)
+            fail(owner, name, value, valid)
         out.append(f)
     return tuple(out)
 
@@ -86,9 +87,9 @@ def check_sequence(owner: str, name: str, value: Any, cls: type[T], allow_empty:
     try:
         items = tuple(items)
     except TypeError:
-        _fail(owner, name, value, valid)
+        fail(owner, name, value, valid)
     if (not items and not allow_empty) or not all(isinstance(item, cls) for item in items):
-        _fail(owner, name, value, valid)
+        fail(owner, name, value, valid)
     return items
 
 
@@ -114,7 +115,7 @@ def check_gauge_pressure(
 def check_choice(owner: str, name: str, value: object, choices: Sequence[str]) -> str:
     """Return ``value`` if it is one of ``choices`` (strings), else raise ValueError."""
     if not isinstance(value, str) or value not in choices:
-        _fail(owner, name, value, "one of " + ", ".join(repr(c) for c in choices))
+        fail(owner, name, value, "one of " + ", ".join(repr(c) for c in choices))
     return value
 
 
@@ -271,7 +272,7 @@ class Drum:
         s(self, "radius", check_real(o, "radius", self.radius, 0.0, 1e6, "m", low_open=True))
         s(self, "centre", check_vector(o, "centre", self.centre, 1e6, "m"))
         if not isinstance(self.inside, bool):
-            _fail(o, "inside", self.inside, "True or False")
+            fail(o, "inside", self.inside, "True or False")
         s(self, "friction", check_real(o, "friction", self.friction, 0.0, 10.0))
         spin = check_real(o, "angular_velocity", self.angular_velocity, -1e4, 1e4, "rad/s")
         s(self, "angular_velocity", spin)
@@ -419,7 +420,7 @@ class Scene:
         s = object.__setattr__
         rings = check_sequence(o, "rings", self.rings, Ring, allow_empty=False)
         if len({r.n_nodes for r in rings}) != 1:
-            _fail(o, "rings", [r.n_nodes for r in rings], "rings with equal n_nodes")
+            fail(o, "rings", [r.n_nodes for r in rings], "rings with equal n_nodes")
         s(self, "rings", rings)
         s(self, "grounds", check_sequence(o, "grounds", self.grounds, Ground, allow_empty=True))
         s(self, "drums", check_sequence(o, "drums", self.drums, Drum, allow_empty=True))
@@ -443,7 +444,7 @@ class Scene:
         s(self, "rho_infinity", check_real(o, "rho_infinity", self.rho_infinity, 0.0, 1.0))
         s(self, "dt", check_real(o, "dt", self.dt, 0.0, 1.0, "s", low_open=True))
         if not isinstance(self.adaptive, bool):
-            _fail(o, "adaptive", self.adaptive, "True or False")
+            fail(o, "adaptive", self.adaptive, "True or False")
         s(
             self,
             "dt_min",
@@ -467,7 +468,7 @@ class Scene:
             if ring.pressure is not None and ring.pressure < 0.0:
                 check_gauge_pressure(o, f"rings[{i}].pressure", ring.pressure, ring, p_atm)
         if not isinstance(self.ring_collision, bool):
-            _fail(o, "ring_collision", self.ring_collision, "True or False")
+            fail(o, "ring_collision", self.ring_collision, "True or False")
         check_choice(o, "self_intersection", self.self_intersection, SELF_INTERSECTION)
 
     @property

@@ -3,7 +3,7 @@
 numba keys a cached kernel on its own file only: after an edit or an upgrade that changes a function
 in another file (a callee it inlined), the old machine code would still load and run. So the cache
 of ``ballenv`` lives in a folder named by a hash of every source file of the packages that hold
-kernels (``ballenv.physics`` and ``ballenv.envs``), numba's version and Python's
+kernels (``ballenv.physics``, ``ballenv.envs`` and ``ballenv.shell``), numba's version and Python's
 (:func:`source_key`): different code, a different folder, never a stale kernel, and checkouts of the
 same code share one cache. The folder sits under the first writable of ``NUMBA_CACHE_DIR`` (if set),
 ``$XDG_CACHE_HOME/ballenv/numba`` (by default ``~/.cache/ballenv/numba``, 0700) and a private folder
@@ -34,7 +34,7 @@ from .compile_lock import private_dir
 from .compile_notice import log_info
 
 PACKAGE = pathlib.Path(__file__).resolve().parents[2]  # ballenv/
-KERNEL_PACKAGES = ("physics", "envs")  # where kernels and the constants they freeze are defined
+KERNEL_PACKAGES = ("physics", "envs", "shell")  # where kernels and the constants they freeze are defined
 KEEP = 4  # cache folders of other sources kept under one parent
 KEY = re.compile(r"[0-9a-f]{16}")
 MOVED = "no writable cache folder in %s: numba's cache of the simulator goes to %s"

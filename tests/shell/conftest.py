@@ -1,0 +1,53 @@
+"""Shared helpers for the shell tests: small models, dense Hessians and central differences."""
+
+import numpy as np
+
+from ballenv.shell.model import build_model, build_workspace
+from ballenv.shell.modes import element_dofs
+from ballenv.shell.scene import Shell
+
+
+def small_model(subdivisions=1, pressure=1e4, gas_exponent=1.4, **kwargs):
+    """A model, its workspace and a randomly deformed configuration (10 % of the radius)."""
+    shell = Shell(radius=0.1, subdivisions=subdivisions, pressure=pressure, position=(0, 0, 0), **kwargs)
+    model = build_model(shell, gas_exponent=gas_exponent)
+    rng = np.random.default_rng(0)
+    x = model.rest + 0.01 * rng.standard_normal(model.rest.shape)
+    return model, build_workspace(model), x
+
+
+def assemble_dense(elements, mats, n_vertices):
+    """The dense (3V, 3V) sum of element matrices."""
+    out = np.zeros((3 * n_vertices, 3 * n_vertices))
+    d = element_dofs(elements)
+    np.add.at(out, (d[:, :, None], d[:, None, :]), mats)
+    return out
+
+
+def central_gradient(f, x, eps=1e-7):
+    """Central differences of the scalar ``f`` at ``x`` (any shape)."""
+    g = np.zeros(x.size)
+    flat = x.reshape(-1)
+    for k in range(flat.size):
+        xp, xm = flat.copy(), flat.copy()
+        xp[k] += eps
+        xm[k] -= eps
+        g[k] = (f(xp.reshape(x.shape)) - f(xm.reshape(x.shape))) / (2 * eps)
+    return g.reshape(x.shape)
+
+
+def central_jacobian(grad, x, eps=1e-7):
+    """Central differences (n, n) of the vector function ``grad`` (returning x's shape) at ``x``."""
+    flat = x.reshape(-1)
+    out = np.zeros((flat.size, flat.size))
+    for k in range(flat.size):
+        xp, xm = flat.copy(), flat.copy()
+        xp[k] += eps
+        xm[k] -= eps
+        out[:, k] = (grad(xp.reshape(x.shape)) - grad(xm.reshape(x.shape))).reshape(-1) / (2 * eps)
+    return out
+
+
+def relative_error(a, b):
+    """max |a - b| / max |b|."""
+    return float(np.abs(a - b).max() / np.abs(b).max())

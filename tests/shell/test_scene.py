@@ -1,0 +1,38 @@
+"""Shell: defaults, derived quantities and the ValueErrors of bad fields."""
+
+import math
+
+import pytest
+
+from ballenv.shell import Shell
+
+
+def test_defaults_and_derived_quantities():
+    shell = Shell()
+    assert shell.n_vertices == 162
+    assert shell.bending_stiffness == pytest.approx(5e6 * 3e-3**3 / (12 * (1 - 0.45**2)))
+    assert Shell(subdivisions=3).n_vertices == 642
+    assert Shell(position=[1, 2, 3]).position == (1.0, 2.0, 3.0)
+
+
+@pytest.mark.parametrize(
+    "field, value, words",
+    [
+        ("radius", -0.1, "Shell.radius = -0.1"),
+        ("radius", math.nan, "Shell.radius"),
+        ("subdivisions", 7, "Shell.subdivisions = 7 is out of range: must be an integer in [0, 6]"),
+        ("subdivisions", 1.5, "Shell.subdivisions"),
+        ("youngs_modulus", 0.0, "(0, 1e+12] Pa"),
+        ("poisson_ratio", 0.6, "Shell.poisson_ratio = 0.6"),
+        ("thickness", 0.1, "Shell.thickness = 0.1 is out of range: must be a finite number in (0, 0.06] m"),
+        ("density", -1.0, "kg/m^3"),
+        ("pressure", math.inf, "Shell.pressure"),
+        ("position", (0, 0), "three finite numbers"),
+        ("velocity", (0, 0, math.nan), "Shell.velocity"),
+        ("angular_velocity", "abc", "Shell.angular_velocity"),
+    ],
+)
+def test_a_bad_field_names_itself_its_value_and_its_range(field, value, words):
+    with pytest.raises(ValueError) as error:
+        Shell(**{field: value})
+    assert words in str(error.value)
