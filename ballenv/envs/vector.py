@@ -5,6 +5,30 @@ Env ``i`` uses the random stream of a single env reset with ``seed + i`` (as ``S
 seeds its envs) and the same compiled step, so it reproduces single envs exactly. Autoreset follows
 Gymnasium's default ``NEXT_STEP`` mode: the step after an episode ends resets that env, ignores its
 action and returns the first observation of the new episode with reward 0.
+
+## Options
+``gym.make_vec`` passes its keyword arguments to :class:`InflatedBallVectorEnv`:
+
+| Keyword | Default | Description |
+|---|---|---|
+| num_envs | 1 | envs stepped together (int in [1, 100000]) |
+| max_episode_steps | 1000 (the id's) | control steps after which an env's episode is truncated |
+| num_threads | the cores, at most num_envs | threads stepping the envs in one call (same numbers) |
+| render_mode | None | None or "rgb_array": a tuple of one frame per env (Pillow) |
+| the env's keywords | as InflatedBall-v3 | ``action_mode``, ``fidelity``, ...: the same for every env |
+
+## Wrappers and vector_kwargs
+The native vector env is ``gym.make_vec``'s default for these ids (they register a vector entry
+point, as Gymnasium's CartPole does). Gymnasium gives a vector entry point neither per-env
+``wrappers`` nor ``vector_kwargs``: it refuses both before the env is built
+(``gymnasium.error.Error: Cannot use `vector_entry_point` vectorization mode with the wrappers
+argument``, or ``... `vector_kwargs` is not empty``). For wrappers around each env, or a vectoriser's
+options (``autoreset_mode``, ``context``, ``shared_memory``, ...), ask for Gymnasium's own
+vectorisation: ``gym.make_vec("InflatedBall-v3", num_envs=2, vectorization_mode="sync",
+wrappers=[...], vector_kwargs={...})`` (``"async"``: one process per env; with ``"ballenv:InflatedBall-v3"``
+in spawned processes). The envs are the same single envs, so the numbers are the native env's. The
+constructor itself (``InflatedBallVectorEnv(...)``) refuses ``wrappers`` and ``vector_kwargs`` with
+the same advice.
 """
 
 from __future__ import annotations
@@ -30,6 +54,7 @@ if TYPE_CHECKING:
     from .render import BallRenderer
 
 DEFAULT_MAX_EPISODE_STEPS = 1000
+VECTORISER_KEYWORDS = {"wrappers", "vector_kwargs"}  # gym.make_vec's, for sync and async only
 
 
 class InflatedBallVectorEnv(VectorEnv[NDArray[np.float32], NDArray[np.float32], NDArray[Any]]):
@@ -54,6 +79,13 @@ class InflatedBallVectorEnv(VectorEnv[NDArray[np.float32], NDArray[np.float32], 
         num_threads: int | None = None,
         **kwargs: Any,
     ) -> None:
+        stray = sorted(VECTORISER_KEYWORDS & set(kwargs))
+        if stray:
+            raise TypeError(
+                f"InflatedBall-v3's native vector env takes no {stray[0]!r}: ask gym.make_vec for "
+                f'vectorization_mode="sync" (or "async") to wrap each env or to set the vectoriser\'s '
+                "options"
+            )
         if isinstance(num_envs, bool) or not isinstance(num_envs, int) or not 1 <= num_envs <= 100_000:
             raise ValueError(
                 f"InflatedBall-v3.num_envs = {num_envs!r} is out of range: must be an integer in [1, 100000]"
