@@ -184,7 +184,8 @@ def test_the_native_vector_env_options_are_documented_in_its_module():
     import ballenv.envs.vector as vector
     from ballenv.envs.inflated_ball import InflatedBallEnv
 
-    documented = vector.__doc__
+    documented = InflatedBallVectorEnv.__doc__  # the API reference's (docs/api/envs.md)
+    assert "InflatedBallVectorEnv" in vector.__doc__
     for name in inspect.signature(InflatedBallVectorEnv.__init__).parameters:
         if name not in ("self", "kwargs"):
             assert f"| {name} |" in documented, name
