@@ -683,7 +683,7 @@ def score(
         text += "\n\n" + verdict(scores[0], scores[1])
     written: list[pathlib.Path] = []
     missing: list[str] = []
-    curve = plot_learning_curve(run, scores)
+    curve = plot_learning_curve(run, scores, trained_for.split(" ", 1)[1])
     if curve is None:
         missing.append("no learning_curve.png: no periodic evaluation ran (--eval-freq above the budget)")
     else:
@@ -743,9 +743,12 @@ def record_clip(
     return path, ""
 
 
-def plot_learning_curve(run: pathlib.Path, scores: Sequence[Score]) -> pathlib.Path | None:
-    """Mean evaluation return against env steps, with the baselines' mean returns as lines, in
-    ``run/learning_curve.png`` (returned); None, and no file, if no periodic evaluation ran."""
+def plot_learning_curve(
+    run: pathlib.Path, scores: Sequence[Score], unit: str = "env steps"
+) -> pathlib.Path | None:
+    """Mean evaluation return against training steps (``unit``: env steps, or bounces behind a
+    bounce-level task), with the baselines' mean returns as lines, in ``run/learning_curve.png``
+    (returned); None, and no file, if no periodic evaluation ran."""
     data = run / "evaluations.npz"
     if not data.exists():
         return None
@@ -762,7 +765,7 @@ def plot_learning_curve(run: pathlib.Path, scores: Sequence[Score]) -> pathlib.P
     ax.fill_between(steps, mean - std, mean + std, alpha=0.2)
     for s, color in zip(scores[1:], ("tab:green", "tab:red"), strict=False):
         ax.axhline(s.episode_return, color=color, ls="--", label=f"{s.policy} (held-out episodes)")
-    ax.set_xlabel("env steps")
+    ax.set_xlabel(unit)
     ax.set_ylabel("episode return")
     ax.set_title(run.name)
     ax.legend(fontsize=8)
