@@ -28,7 +28,9 @@ venv: $(STAMP)
 
 # PPO started from a clone of the privileged lookahead's demonstrations (60 episodes on training
 # seeds), 2,048 bounces of PPO, then the scoreboard on 30 held-out episodes (seeds 10,000 on), the
-# learning curve and a clip in runs/ppo_pressure_seed0 (train.py --help; agents/train.py)
+# learning curve and a clip in runs/ppo_pressure_seed0 (train.py --help; agents/train.py). Measured
+# (python benchmarks/make_train.py): 287 s on 2 cores shared at load 3.5, with a warm numba cache;
+# the first run after an install also compiles the simulator (10 min in all at load 2.7-5.5)
 train: $(TRAIN_STAMP)
 	$(PY) train.py --algo ppo --action-mode pressure --warm-start clone --demo-episodes 60 \
 		--total-timesteps 2048 --eval-freq 1024 --final-episodes 30 --vec-env subproc --log-dir runs
