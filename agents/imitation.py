@@ -80,6 +80,16 @@ class Demonstrations:
         np.savez(path, **self.__dict__)
 
     @classmethod
+    def concatenate(cls, parts: Sequence[Demonstrations]) -> Demonstrations:
+        """The demonstrations of ``parts`` (of one task) one after the other."""
+        wrappers = {d.wrapper for d in parts}
+        if len(wrappers) != 1:
+            raise ValueError(f"demonstrations of several tasks ({sorted(wrappers)}) cannot be joined")
+        names = [name for name in cls.__dataclass_fields__ if name != "wrapper"]
+        arrays = {name: np.concatenate([getattr(d, name) for d in parts]) for name in names}
+        return cls(parts[0].wrapper, **arrays)
+
+    @classmethod
     def load(cls, path: str | pathlib.Path) -> Demonstrations:
         """The demonstrations saved in ``path``; a ``ValueError`` if their task is not one of
         ``WRAPPERS``."""
@@ -131,6 +141,31 @@ def record(
     arrays["next_observations"] = arrays["next_observations"].astype(np.float32)
     arrays["actions"] = arrays["actions"].astype(np.float32)
     return Demonstrations(wrapper, **arrays)
+
+
+def record_in_parallel(
+    env_kwargs: dict[str, Any],
+    episodes: int,
+    seed: int = 0,
+    wrapper: str = WRAPPERS[0],
+    workers: int = 1,
+) -> Demonstrations:
+    """:func:`record`'s demonstrations of episodes ``seed .. seed + episodes - 1``, in ``workers``
+    spawned processes, each recording a contiguous share of the seeds: the same arrays, in the same
+    order, as one :func:`record` of them all (an episode depends on its seed only)."""
+    workers = max(1, min(workers, episodes))
+    if workers == 1:
+        return record(env_kwargs, episodes, seed, wrapper)
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    bounds = np.linspace(0, episodes, workers + 1).round().astype(int)
+    shares = [(int(a), int(b - a)) for a, b in zip(bounds[:-1], bounds[1:], strict=True) if b > a]
+    context = multiprocessing.get_context("spawn")  # no fork of a process holding torch's threads
+    with ProcessPoolExecutor(len(shares), mp_context=context) as pool:
+        jobs = [pool.submit(record, env_kwargs, n, seed + a, wrapper, False) for a, n in shares]
+        parts = [job.result() for job in jobs]
+    return Demonstrations.concatenate(parts)
 
 
 def regress(

@@ -5,13 +5,19 @@
     ballenv-train --algo ppo --env-kwargs '{"fidelity": "balanced"}' --n-envs 2   # when installed
     python train.py --algo ppo --action-mode paddle --conf-file ppo_cloned \
         --demonstrations runs/demonstrations_paddle.npz                   # cloned, then PPO
+    python train.py --action-mode pressure --warm-start clone --demo-episodes 60 \
+        --total-timesteps 2048 --final-episodes 30 --vec-env subproc     # make train: all in one
 
 Hyperparameters come from ``agents/hyperparams/{algo}.yml``, or ``--conf-file`` (one entry per env
 id, i.e. per action mode; the command line overrides the budget, the number of envs and the env
 keyword arguments).
 ``--demonstrations`` pretrains a PPO policy on the privileged lookahead's demonstrations of a
 bounce-level task (``agents.imitation``) and evaluates it before the first update, so the best
-model may be the clone itself. A run writes one folder ``{log_dir}/{algo}_{mode}_seed{seed}[_k]`` holding:
+model may be the clone itself. ``--warm-start clone`` does it all in one command: it records the
+lookahead's demonstrations of ``--demo-episodes`` episodes (training seeds from ``DEMO_SEED``, one
+process per core with ``--vec-env subproc``; kept as ``demonstrations.npz``), clones them and runs
+PPO with ``--conf-file`` (default ``ppo_cloned``). A run writes one folder
+``{log_dir}/{algo}_{mode}_seed{seed}[_k]`` holding:
 
 * ``config.yml`` (algorithm, hyperparameters, env keyword arguments, seed, versions) and
   ``command.txt`` (the exact command);
@@ -19,8 +25,14 @@ model may be the clone itself. A run writes one folder ``{log_dir}/{algo}_{mode}
   (best periodic evaluation), ``signatures.json`` (their HMACs under this user's key, so that
   evaluation loads them without ``--trust``: ``agents.signatures``), ``checkpoints/``,
   ``evaluations.npz``, Monitor logs and TensorBoard logs (``tensorboard --logdir runs``);
-* ``scores.md`` / ``scores.json``: the best model, the heuristic and random actions scored by
-  ``agents.evaluate`` on the same held-out seeds, and ``learning_curve.png``.
+* ``scores.md`` / ``scores.json``: the scoreboard: the best model, the heuristic and random actions
+  scored by ``agents.evaluate`` on the same held-out seeds (10,000 on: never trained or cloned on),
+  with reference rows read from results files (:mod:`agents.scoreboard`), whether the agent beats
+  the heuristic (95 % intervals apart) and each phase's wall time; ``learning_curve.png`` (if a
+  periodic evaluation ran) and ``clip.gif``, the trained agent's first 4 s of the first held-out
+  episode (if Pillow is installed). The output names what was written, and what was not and why.
+* TensorBoard's ``task/apex_error``, ``task/success_rate`` and ``task/apexes``: the training
+  episodes' apexes per rollout (:func:`task_metrics`).
 """
 
 from __future__ import annotations
@@ -52,16 +64,18 @@ if TYPE_CHECKING:
 from ballenv.files import write_text
 
 from . import checkpoints
-from .config import UsageError, env_id, load_hyperparams, parse_env_kwargs, task_env_kwargs
-from .evaluate import Score, evaluate, table
-from .imitation import TASKS, WRAPPERS, Demonstrations, pretrain
+from .config import SUCCESS_TOLERANCE, UsageError, env_id, load_hyperparams, parse_env_kwargs, task_env_kwargs
+from .evaluate import DEFAULT_SEED, Score, evaluate
+from .imitation import TASKS, WRAPPERS, Demonstrations, pretrain, record_in_parallel
 from .normalization import save as save_normalization
+from .scoreboard import board, references, verdict
 from .signatures import sign
 from .wrappers import wrapper_class
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent  # holds agents/: on a Ray worker's PYTHONPATH
 RUN_KEYS = ("n_timesteps", "n_envs", "policy", "normalize", "env_kwargs", "env_wrapper")
 OnEvaluation = Callable[[int, float], bool]  # (env steps, mean return) -> go on training
+DEMO_SEED = 5_000  # --warm-start clone's demonstrations: training seeds from here (held-out: 10,000 on)
 
 
 def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
@@ -96,6 +110,17 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
         "--demonstrations", default=None, metavar="FILE",
         help="pretrain the policy on these lookahead demonstrations (python -m agents.imitation) "
         "before learning; PPO behind the bounce-level task they were recorded in",
+    )  # fmt: skip
+    p.add_argument(
+        "--warm-start", choices=("none", "clone"), default="none",
+        help="clone: record the lookahead's demonstrations (--demo-episodes, on training seeds; or "
+        "read --demonstrations), clone them into the policy, then PPO with --conf-file (default "
+        "ppo_cloned); what make train runs",
+    )  # fmt: skip
+    p.add_argument(
+        "--demo-episodes", type=int, default=40,
+        help="episodes the lookahead demonstrates for --warm-start clone (about 6 s each on one core, "
+        "recorded in one process per env up to the cores)",
     )  # fmt: skip
     p.add_argument("--no-baselines", action="store_true", help="score only the trained agent at the end")
     p.add_argument(
@@ -277,7 +302,38 @@ def callbacks(
         save_freq=max(total // (5 * n_envs), 1), save_path=str(run / "checkpoints"), name_prefix="model",
         save_vecnormalize=True,
     )  # fmt: skip
-    return [evaluation, checkpoints, ProgressBar()]
+    return [evaluation, checkpoints, ProgressBar(), task_metrics()]
+
+
+def task_metrics() -> BaseCallback:
+    """A callback that logs the task's measures of the training episodes' flight apexes with each
+    rollout (TensorBoard's ``task/apex_error``: the mean of ``|h - h_target| / h_target`` over the
+    rollout's apexes; ``task/success_rate``: the share of them within ``SUCCESS_TOLERANCE``;
+    ``task/apexes``: how many), read from the envs' ``info`` (``apex_count``, ``apex_height``,
+    ``target_height``: a bounce-level task's step reports the apex that ended it). A rollout
+    without an apex logs nothing."""
+    from stable_baselines3.common.callbacks import BaseCallback
+
+    class TaskMetrics(BaseCallback):
+        def _on_rollout_start(self) -> None:
+            self.errors: list[float] = []
+
+        def _on_step(self) -> bool:
+            for info in self.locals.get("infos", ()):
+                if info.get("apex_count", 0) > 0:
+                    target = float(info["target_height"])
+                    self.errors.append(abs(float(info["apex_height"]) - target) / target)
+            return True
+
+        def _on_rollout_end(self) -> None:
+            if not self.errors:
+                return
+            errors = np.asarray(self.errors)
+            self.logger.record("task/apex_error", float(errors.mean()))
+            self.logger.record("task/success_rate", float(np.mean(errors <= SUCCESS_TOLERANCE)))
+            self.logger.record("task/apexes", int(errors.size))
+
+    return TaskMetrics()
 
 
 def check_hyperparams(cls: type[BaseAlgorithm], algo_kwargs: Mapping[str, Any]) -> None:
@@ -326,16 +382,38 @@ def schedules(algo_kwargs: Mapping[str, Any]) -> dict[str, Any]:
     return out
 
 
+def check_demonstrated_task(args: argparse.Namespace, wrapper: str | None, option: str) -> None:
+    """A :class:`UsageError` naming ``option`` unless the run is PPO behind a demonstrated task's
+    wrapper (``agents.imitation.TASKS``) of its action mode."""
+    if args.algo != "ppo" or wrapper not in WRAPPERS or TASKS[wrapper] != args.action_mode:
+        raise UsageError(
+            f"{option} needs --algo ppo and an env_wrapper of its --action-mode among {TASKS}; "
+            f"got {args.algo}, {args.action_mode}, {wrapper}"
+        )
+
+
+def demonstration_seed(args: argparse.Namespace) -> int:
+    """The seed of the first episode ``--warm-start clone`` demonstrates: ``DEMO_SEED`` plus the
+    run's seed times ``--demo-episodes`` (runs of different seeds clone different episodes); all of
+    them below the held-out episodes' seeds (``agents.evaluate.DEFAULT_SEED``), or a
+    :class:`UsageError`."""
+    if args.demo_episodes < 1:
+        raise UsageError(f"--demo-episodes = {args.demo_episodes} is invalid: must be >= 1")
+    first = DEMO_SEED + args.seed * args.demo_episodes
+    if first < 0 or first + args.demo_episodes > DEFAULT_SEED:
+        raise UsageError(
+            f"--seed {args.seed} with --demo-episodes {args.demo_episodes}: the demonstrations' seeds "
+            f"{first}..{first + args.demo_episodes - 1} must lie in [0, {DEFAULT_SEED}) (held-out from there)"
+        )
+    return first
+
+
 def load_demonstrations(args: argparse.Namespace, wrapper: str | None) -> Demonstrations | None:
     """The demonstrations of ``args.demonstrations`` (None if not given); a :class:`UsageError` if
     the file does not load or the run is not PPO behind their task's wrapper."""
     if args.demonstrations is None:
         return None
-    if args.algo != "ppo" or wrapper not in WRAPPERS or TASKS[wrapper] != args.action_mode:
-        raise UsageError(
-            f"--demonstrations needs --algo ppo and an env_wrapper of its --action-mode among {TASKS}; "
-            f"got {args.algo}, {args.action_mode}, {wrapper}"
-        )
+    check_demonstrated_task(args, wrapper, "--demonstrations")
     try:
         demonstrations = Demonstrations.load(args.demonstrations)
     except (OSError, ValueError, KeyError) as err:
@@ -374,7 +452,8 @@ class Plan:
     cls: Any  # the Stable-Baselines3 algorithm
     model_kwargs: dict[str, Any]  # with RL Zoo's schedules resolved
     gamma: float
-    demonstrations: Demonstrations | None
+    demonstrations: Demonstrations | None  # read from --demonstrations
+    demo_seed: int | None  # --warm-start clone without a file: record episodes from this seed
 
 
 def plan(args: argparse.Namespace) -> Plan:
@@ -384,9 +463,17 @@ def plan(args: argparse.Namespace) -> Plan:
     if args.resume:
         args, hp = resumed(args)
     else:
+        if args.warm_start == "clone" and args.algo != "ppo":
+            check_demonstrated_task(args, None, "--warm-start clone")
+        if args.warm_start == "clone" and args.conf_file is None:
+            args = argparse.Namespace(**{**vars(args), "conf_file": "ppo_cloned"})
         hp = load_hyperparams(args.algo, args.action_mode, args.conf_file)
         hp.update(args.hyperparams or {})
     wrapper = hp.get("env_wrapper")
+    demo_seed = None
+    if args.warm_start == "clone":
+        check_demonstrated_task(args, wrapper, "--warm-start clone")
+        demo_seed = None if args.demonstrations else demonstration_seed(args)
     algo_kwargs = {k: v for k, v in hp.items() if k not in RUN_KEYS}
     classes: dict[str, type[PPO] | type[SAC]] = {"ppo": PPO, "sac": SAC}
     cls = classes[args.algo]
@@ -400,7 +487,7 @@ def plan(args: argparse.Namespace) -> Plan:
         n_envs=args.n_envs or int(hp.get("n_envs", 1)), total=args.total_timesteps or int(hp["n_timesteps"]),
         normalize=bool(hp.get("normalize", True)), wrapper=wrapper, algo_kwargs=algo_kwargs, cls=cls,
         model_kwargs=schedules(algo_kwargs), gamma=float(algo_kwargs.get("gamma", 0.99)),
-        demonstrations=load_demonstrations(args, wrapper),
+        demonstrations=load_demonstrations(args, wrapper), demo_seed=demo_seed,
     )  # fmt: skip
 
 
@@ -415,7 +502,8 @@ def run_config(p: Plan) -> dict[str, Any]:
         "total_timesteps": p.total, "n_envs": p.n_envs, "normalize": p.normalize,
         "policy": p.hp.get("policy", "MlpPolicy"), "env_wrapper": p.wrapper,
         "hyperparams": p.algo_kwargs, "eval_freq": a.eval_freq, "eval_episodes": a.eval_episodes,
-        "vec_env": a.vec_env, "demonstrations": a.demonstrations,
+        "vec_env": a.vec_env, "demonstrations": a.demonstrations, "warm_start": a.warm_start,
+        "demo_episodes": a.demo_episodes if p.demo_seed is not None else None, "demo_seed": p.demo_seed,
         "versions": {"stable_baselines3": str(stable_baselines3.__version__),
                      "torch": str(torch.__version__)},
     }  # fmt: skip
@@ -461,8 +549,14 @@ def train(args: argparse.Namespace, on_evaluation: OnEvaluation | None = None) -
     training. If the setup fails (an invalid env keyword, an algorithm that refuses its
     hyperparameters, ...), the run folder is removed again before the error propagates; the first
     Ctrl-C saves the resumable state (:mod:`agents.checkpoints`) and raises KeyboardInterrupt."""
+    began = time.perf_counter()
     p = plan(args)
     args = p.args
+    phases: dict[str, float] = {}  # wall time (s) of each phase of the run
+    demonstrations = p.demonstrations
+    if p.demo_seed is not None:
+        demonstrations = demonstrate(p)
+        phases["demonstrations"] = time.perf_counter() - began
     made_log_dir = not pathlib.Path(args.log_dir).exists()
     run = (
         pathlib.Path(args.resume)
@@ -471,25 +565,48 @@ def train(args: argparse.Namespace, on_evaluation: OnEvaluation | None = None) -
     )
     done = checkpoints.steps_done(run) if args.resume else 0
     envs, eval_env, model = set_up(run, p, made_log_dir)
-    if p.demonstrations is not None:
-        fit = pretrain(model, envs, p.demonstrations)
+    if demonstrations is not None:
+        start = time.perf_counter()
+        if p.demo_seed is not None:
+            demonstrations.save(run / "demonstrations.npz")
+        fit = pretrain(model, envs, demonstrations)
         action, value = fit["action_mse"], fit["value_mse"]
-        print(f"pretrained on {len(p.demonstrations.actions)} demonstrated bounces: held-back mean "
-              f"squared error of the action {action:.2e}, of the value {value:.2e}")  # fmt: skip
+        phases["cloning"] = time.perf_counter() - start
+        print(f"pretrained on {len(demonstrations.actions)} demonstrated bounces in "
+              f"{phases['cloning']:.0f} s: held-back mean squared error of the action {action:.2e}, "
+              f"of the value {value:.2e}")  # fmt: skip
     start = time.perf_counter()
-    steps = callbacks(run, eval_env, args, p.n_envs, p.total, on_evaluation, p.demonstrations is not None)
+    steps = callbacks(run, eval_env, args, p.n_envs, p.total, on_evaluation, demonstrations is not None)
     with checkpoints.CtrlC() as ctrl_c:
         steps += [checkpoints.every(run, args.checkpoint_minutes), ctrl_c.callback()]
         model.learn(total_timesteps=p.total - done, callback=steps, reset_num_timesteps=not args.resume)
     if ctrl_c.requested:
         interrupted(run, model, envs, eval_env)
-    wall = time.perf_counter() - start
+    wall = phases[args.algo] = time.perf_counter() - start
     finish(run, model, envs, eval_env)
-    print(f"trained {args.algo} for {model.num_timesteps} env steps in {wall:.0f} s "
-          f"({wall / model.num_timesteps * 1e5:.0f} s per 100k steps); run folder {run}")  # fmt: skip
+    unit = "bounces" if p.wrapper in TASKS else "env steps"  # a bounce-level task's step is a bounce
+    print(f"trained {args.algo} for {model.num_timesteps} {unit} in {wall:.0f} s "
+          f"({wall / model.num_timesteps * 1e5:.0f} s per 100k {unit}); run folder {run}")  # fmt: skip
     if args.final_episodes > 0:
-        score(run, args, p.env_kwargs, wall, model.num_timesteps)
+        score(run, args, p.env_kwargs, phases, f"{model.num_timesteps} {unit}", began)
     return run
+
+
+def demonstrate(p: Plan) -> Demonstrations:
+    """``--warm-start clone``'s demonstrations: the lookahead playing ``--demo-episodes`` episodes
+    of the run's task from ``p.demo_seed`` (training seeds), in one process per core with
+    ``--vec-env subproc``."""
+    a = p.args
+    workers = min(os.cpu_count() or 1, a.demo_episodes) if a.vec_env == "subproc" else 1
+    start = time.perf_counter()
+    assert p.demo_seed is not None and p.wrapper is not None  # plan checked the task
+    seeds = f"{p.demo_seed}..{p.demo_seed + a.demo_episodes - 1}"
+    print(f"recording the lookahead's demonstrations of {a.demo_episodes} episodes (seeds {seeds}) in "
+          f"{workers} process{'es' if workers > 1 else ''}", flush=True)  # fmt: skip
+    demonstrations = record_in_parallel(p.env_kwargs, a.demo_episodes, p.demo_seed, p.wrapper, workers)
+    wall = time.perf_counter() - start
+    print(f"recorded {len(demonstrations.actions)} demonstrated bounces in {wall:.0f} s")
+    return demonstrations
 
 
 def finish(run: pathlib.Path, model: BaseAlgorithm, envs: VecEnv, eval_env: VecEnv) -> None:
@@ -536,34 +653,105 @@ def resumed(args: argparse.Namespace) -> tuple[argparse.Namespace, dict[str, Any
         "env_kwargs": config["env_kwargs"], "seed": config["seed"], "n_envs": config["n_envs"],
         "total_timesteps": config["total_timesteps"], "eval_freq": config["eval_freq"],
         "eval_episodes": config["eval_episodes"], "vec_env": config["vec_env"],
-        "demonstrations": None, "conf_file": None, "hyperparams": None,
+        "demonstrations": None, "conf_file": None, "hyperparams": None, "warm_start": "none",
     })  # fmt: skip
     return new, hp
 
 
 def score(
-    run: pathlib.Path, args: argparse.Namespace, env_kwargs: dict[str, Any], wall: float, steps: int
+    run: pathlib.Path,
+    args: argparse.Namespace,
+    env_kwargs: dict[str, Any],
+    phases: dict[str, float],
+    trained_for: str,
+    began: float,
 ) -> None:
-    """Score the best model and the baselines on the same held-out seeds; write tables and a plot."""
+    """Score the best model and the baselines on the same held-out seeds; write the scoreboard
+    (with the reference rows of :mod:`agents.scoreboard`), the learning curve and a clip of the
+    trained agent; say what was written, and what was not and why. ``phases``: the wall time (s)
+    of the run's phases so far; ``began``: ``time.perf_counter()`` at the run's start."""
+    start = time.perf_counter()
     best = run / "best_model.zip"
     policy = best if best.exists() else run / "model.zip"
     specs = [str(policy)] + ([] if args.no_baselines else ["heuristic", "random"])
     scores = [evaluate(s, env_kwargs, args.final_episodes, algo=args.algo, progress=True) for s in specs]
     scores[0] = type(scores[0])(**{**asdict(scores[0]), "policy": f"{args.algo} ({policy.name})"})
-    text = table(scores)
-    print(text)
-    header = f"{args.algo}, {args.action_mode} mode, {steps} env steps in {wall:.0f} s, seed {args.seed}\n\n"
+    phases["scoring"] = time.perf_counter() - start
+    refs = references(args.action_mode, args.algo, pathlib.Path(args.log_dir))
+    text = board(scores, refs, DEFAULT_SEED)
+    if not args.no_baselines:
+        text += "\n\n" + verdict(scores[0], scores[1])
+    written: list[pathlib.Path] = []
+    missing: list[str] = []
+    curve = plot_learning_curve(run, scores, trained_for.split(" ", 1)[1])
+    if curve is None:
+        missing.append("no learning_curve.png: no periodic evaluation ran (--eval-freq above the budget)")
+    else:
+        written.append(curve)
+    clip, why = record_clip(run / "clip.gif", policy, env_kwargs, args.algo)
+    if clip is None:
+        missing.append(why)
+    else:
+        written.append(clip)
+    phases["total"] = time.perf_counter() - began
+    timing = ", ".join(f"{name} {seconds:.0f} s" for name, seconds in phases.items())
+    header = f"{args.algo}, {args.action_mode} mode, {trained_for}, seed {args.seed}; wall time: {timing}\n\n"
     write_text(run / "scores.md", header + text + "\n")
     write_text(run / "scores.json", json.dumps([asdict(s) for s in scores], indent=2))
-    plot_learning_curve(run, scores)
-    print(f"wrote {run / 'scores.md'} and {run / 'learning_curve.png'}")
+    print(header + text)
+    files = [run / "scores.md", run / "scores.json", *written]
+    print(f"wrote {', '.join(str(f) for f in files)}")
+    for line in missing:
+        print(line)
 
 
-def plot_learning_curve(run: pathlib.Path, scores: Sequence[Score]) -> None:
-    """Mean evaluation return against env steps, with the baselines' mean returns as lines."""
+def record_clip(
+    path: pathlib.Path, policy: pathlib.Path, env_kwargs: dict[str, Any], algo: str, seconds: float = 4.0
+) -> tuple[pathlib.Path | None, str]:
+    """A GIF at ``path`` of the saved model ``policy`` playing the first held-out episode's first
+    ``seconds`` (s) of simulated time, every fourth control step (25 frames per second of simulated
+    time at 100 Hz control), in real time; ``(path, "")``, or ``(None, why not)`` if Pillow (the
+    render extra) is not installed."""
+    from ballenv.extras import render_modes
+
+    if "rgb_array" not in render_modes():
+        return None, "no clip.gif: the render extra is not installed (pip install 'ballenv[render]')"
+    import gymnasium as gym
+    from PIL import Image
+
+    from .baselines import make_policy
+    from .config import ENV_ID
+
+    env = gym.make(ENV_ID, **env_kwargs, render_mode="rgb_array")
+    agent = make_policy(str(policy), env, algo)
+    every = 4
+    fps = float(env.metadata["render_fps"])
+    obs, _ = env.reset(seed=DEFAULT_SEED)
+    agent.reset(DEFAULT_SEED)
+    frames = []
+    for k in range(round(seconds * fps) + 1):
+        if k % every == 0:
+            frame = env.render()
+            assert isinstance(frame, np.ndarray)  # rgb_array
+            frames.append(Image.fromarray(frame).quantize(colors=64, dither=Image.Dither.NONE))
+        obs, _, terminated, truncated, _ = env.step(agent.act(obs))
+        if terminated or truncated:
+            break
+    env.close()
+    duration = round(1000 * every / fps)  # ms per frame: real time
+    frames[0].save(path, save_all=True, append_images=frames[1:], duration=duration, loop=0, optimize=True)
+    return path, ""
+
+
+def plot_learning_curve(
+    run: pathlib.Path, scores: Sequence[Score], unit: str = "env steps"
+) -> pathlib.Path | None:
+    """Mean evaluation return against training steps (``unit``: env steps, or bounces behind a
+    bounce-level task), with the baselines' mean returns as lines, in ``run/learning_curve.png``
+    (returned); None, and no file, if no periodic evaluation ran."""
     data = run / "evaluations.npz"
     if not data.exists():
-        return
+        return None
     import matplotlib
 
     matplotlib.use("Agg")
@@ -577,13 +765,14 @@ def plot_learning_curve(run: pathlib.Path, scores: Sequence[Score]) -> None:
     ax.fill_between(steps, mean - std, mean + std, alpha=0.2)
     for s, color in zip(scores[1:], ("tab:green", "tab:red"), strict=False):
         ax.axhline(s.episode_return, color=color, ls="--", label=f"{s.policy} (held-out episodes)")
-    ax.set_xlabel("env steps")
+    ax.set_xlabel(unit)
     ax.set_ylabel("episode return")
     ax.set_title(run.name)
     ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(run / "learning_curve.png", dpi=120)
     plt.close(fig)
+    return run / "learning_curve.png"
 
 
 if __name__ == "__main__":

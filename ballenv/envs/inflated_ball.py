@@ -135,6 +135,13 @@ class InflatedBallEnv(Env[NDArray[np.float32], NDArray[np.float32]], EzPickle):
     | rest_height                 | float | 0.01           | the ball is at rest when it could rise no more (m) |
     | render_mode                 | str   | None           | "human" or "rgb_array"; one frame per control step, ``metadata["render_fps"]`` = control_frequency (real time) |
 
+    ## Vector Environments
+    ``gym.make_vec("InflatedBall-v3", num_envs=n, **kwargs)`` builds the native vector env by default
+    (``vectorization_mode="vector_entry_point"``: every ball stepped in one compiled call, on
+    ``num_threads`` threads; its options are in ``ballenv.envs.vector``). Gymnasium passes it no
+    ``wrappers`` and no ``vector_kwargs``: with either, ask for ``vectorization_mode="sync"`` (or
+    ``"async"``), which steps these same single envs one after the other.
+
     ## Version History
     - v3: the paddle strikes only a ball in flight, not one squashing on the ground (paddle dynamics; the observation, the reward and the pressure mode are as in v2). v2 is no longer registered.
     - v2: smooth actuation: the gas amount ramps to its setpoint over the control step and a strike delivers its impulse over ``paddle_strike_duration`` (new keyword), both stepped by the simulator. v1 is no longer registered.

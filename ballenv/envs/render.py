@@ -83,7 +83,9 @@ class BallRenderer:
         return [
             f"t = {task.steps[e] * task.control_dt:5.2f} s",
             f"p = {pressure / 1e3:6.1f} kPa (gas {task.setpoint[e] / 1e3:4.1f} kPa at rest)",
-            f"target {task.target[e]:.2f} m, last apex {task.apex_height[e]:.2f} m",
+            # the last flight apex (the start height before the first): the task's apex_height is
+            # the apex of the last control step only, 0 at every step without one
+            f"target {task.target[e]:.2f} m, last apex {task.last_apex[e]:.2f} m",
         ]
 
     def _show(self, frame: NDArray[np.uint8]) -> None:

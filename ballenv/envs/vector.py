@@ -4,7 +4,8 @@
 Env ``i`` uses the random stream of a single env reset with ``seed + i`` (as ``SyncVectorEnv``
 seeds its envs) and the same compiled step, so it reproduces single envs exactly. Autoreset follows
 Gymnasium's default ``NEXT_STEP`` mode: the step after an episode ends resets that env, ignores its
-action and returns the first observation of the new episode with reward 0.
+action and returns the first observation of the new episode with reward 0. Its options, and what
+to ask ``gym.make_vec`` for to wrap each env: :class:`InflatedBallVectorEnv`.
 """
 
 from __future__ import annotations
@@ -30,6 +31,7 @@ if TYPE_CHECKING:
     from .render import BallRenderer
 
 DEFAULT_MAX_EPISODE_STEPS = 1000
+VECTORISER_KEYWORDS = {"wrappers", "vector_kwargs"}  # gym.make_vec's, for sync and async only
 
 
 class InflatedBallVectorEnv(VectorEnv[NDArray[np.float32], NDArray[np.float32], NDArray[Any]]):
@@ -38,7 +40,32 @@ class InflatedBallVectorEnv(VectorEnv[NDArray[np.float32], NDArray[np.float32], 
 
     ``num_threads`` (default: numba's thread count, the machine's cores, at most ``num_envs``) steps
     the envs on that many threads in one compiled call; every env's numbers are those of a single
-    env, to the bit, whatever the thread count."""
+    env, to the bit, whatever the thread count.
+
+    ## Options
+    ``gym.make_vec`` passes its keyword arguments to :class:`InflatedBallVectorEnv`:
+
+    | Keyword | Default | Description |
+    |---|---|---|
+    | num_envs | 1 | envs stepped together (int in [1, 100000]) |
+    | max_episode_steps | 1000 (the id's) | control steps after which an env's episode is truncated |
+    | num_threads | the cores, at most num_envs | threads stepping the envs in one call (same numbers) |
+    | render_mode | None | None or "rgb_array": a tuple of one frame per env (Pillow) |
+    | the env's keywords | as InflatedBall-v3 | ``action_mode``, ``fidelity``, ...: the same for every env |
+
+    ## Wrappers and vector_kwargs
+    The native vector env is ``gym.make_vec``'s default for these ids (they register a vector
+    entry point, as Gymnasium's CartPole does). Gymnasium gives a vector entry point neither
+    per-env ``wrappers`` nor ``vector_kwargs``: it refuses both before the env is built
+    (``gymnasium.error.Error: Cannot use `vector_entry_point` vectorization mode with the wrappers
+    argument``, or ``... `vector_kwargs` is not empty``). For wrappers around each env, or a
+    vectoriser's options (``autoreset_mode``, ``context``, ``shared_memory``, ...), ask for
+    Gymnasium's own vectorisation: ``gym.make_vec("InflatedBall-v3", num_envs=2,
+    vectorization_mode="sync", wrappers=[...], vector_kwargs={...})`` (``"async"``: one process
+    per env, ``"ballenv:InflatedBall-v3"`` in spawned processes). Its envs are the same single
+    envs, so the numbers are the native env's. The constructor itself refuses ``wrappers`` and
+    ``vector_kwargs`` with the same advice.
+    """
 
     metadata = {
         "render_modes": [m for m in render_modes() if m == "rgb_array"],  # Pillow installed
@@ -54,6 +81,13 @@ class InflatedBallVectorEnv(VectorEnv[NDArray[np.float32], NDArray[np.float32], 
         num_threads: int | None = None,
         **kwargs: Any,
     ) -> None:
+        stray = sorted(VECTORISER_KEYWORDS & set(kwargs))
+        if stray:
+            raise TypeError(
+                f"InflatedBall-v3's native vector env takes no {stray[0]!r}: ask gym.make_vec for "
+                f'vectorization_mode="sync" (or "async") to wrap each env or to set the vectoriser\'s '
+                "options"
+            )
         if isinstance(num_envs, bool) or not isinstance(num_envs, int) or not 1 <= num_envs <= 100_000:
             raise ValueError(
                 f"InflatedBall-v3.num_envs = {num_envs!r} is out of range: must be an integer in [1, 100000]"

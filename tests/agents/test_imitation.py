@@ -138,3 +138,15 @@ def test_paddle_demonstrations_are_the_lookahead_striking():
     np.testing.assert_array_equal(d.next_observations[:-1], d.observations[1:])
     assert np.all(np.abs(d.actions) < 1.0) and np.all((0.0 <= d.rewards) & (d.rewards <= 1.0))
     assert np.median(d.rewards) > 0.5  # the lookahead's bounces land near the target
+
+
+def test_demonstrations_recorded_in_processes_are_the_serial_ones(demonstrations):
+    from agents.imitation import record_in_parallel
+
+    parallel = record_in_parallel(SHORT, episodes=2, seed=0, wrapper=WRAPPER, workers=2)
+    assert parallel.wrapper == demonstrations.wrapper
+    for name in ("observations", "actions", "rewards", "next_observations", "terminated", "ended"):
+        np.testing.assert_array_equal(getattr(parallel, name), getattr(demonstrations, name), err_msg=name)
+    other = Demonstrations(**{**demonstrations.__dict__, "wrapper": "agents.wrappers.PumpApex"})
+    with pytest.raises(ValueError, match="several tasks"):
+        Demonstrations.concatenate([demonstrations, other])

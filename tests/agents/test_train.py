@@ -5,6 +5,7 @@ import pathlib
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 import yaml
 
@@ -157,3 +158,83 @@ def test_rl_zoo_linear_schedules_are_read_and_a_malformed_one_is_named():
         schedules({"learning_rate": "exp_3e-4"})
     with pytest.raises(UsageError, match="clip_range = 'lin_x'"):
         schedules({"clip_range": "lin_x"})
+
+
+@pytest.fixture(scope="module")
+def unevaluated_run(tmp_path_factory):
+    """A tiny run whose budget ends before its first periodic evaluation: (run folder, its output)."""
+    import contextlib
+    import io
+
+    log_dir = tmp_path_factory.mktemp("runs")
+    out = io.StringIO()
+    args = [
+        "--n-envs", "1", "--total-timesteps", "256", "--eval-freq", "100000", "--final-episodes", "1",
+        "--no-baselines", "--log-dir", str(log_dir), "--env-kwargs", json.dumps({"max_episode_steps": 150}),
+        "--hyperparams", json.dumps({"n_steps": 128, "batch_size": 64, "n_epochs": 1}),
+    ]  # fmt: skip
+    with contextlib.redirect_stdout(out):
+        run = train(parse_args(args))
+    return run, out.getvalue()
+
+
+def test_only_what_was_written_is_said_to_be(unevaluated_run):
+    run, out = unevaluated_run
+    assert not (run / "evaluations.npz").exists() and not (run / "learning_curve.png").exists()
+    wrote = next(line for line in out.splitlines() if line.startswith("wrote "))
+    assert "learning_curve.png" not in wrote and "scores.md" in wrote
+    assert "no learning_curve.png: no periodic evaluation ran" in out
+    for name in wrote.removeprefix("wrote ").split(", "):
+        assert pathlib.Path(name).exists(), name
+
+
+def test_tensorboard_gets_the_task_measures_of_the_training_apexes(unevaluated_run):
+    from tensorboard.backend.event_processing.event_accumulator import EventAccumulator
+
+    run, _ = unevaluated_run
+    (events,) = (run / "tensorboard").rglob("events.out.tfevents*")
+    log = EventAccumulator(str(events.parent))
+    log.Reload()
+    tags = log.Tags()["scalars"]
+    assert {"task/apex_error", "task/success_rate", "task/apexes"} <= set(tags), tags
+    errors = [e.value for e in log.Scalars("task/apex_error")]
+    shares = [e.value for e in log.Scalars("task/success_rate")]
+    assert errors and all(0.0 <= e < 5.0 for e in errors) and all(0.0 <= s <= 1.0 for s in shares)
+    assert all(e.value >= 1 for e in log.Scalars("task/apexes"))
+
+
+def test_warm_start_clone_records_clones_and_scores_with_references_in_one_command(tmp_path):
+    args = [
+        "--warm-start", "clone", "--demo-episodes", "2", "--n-envs", "1", "--total-timesteps", "8",
+        "--eval-freq", "4", "--eval-episodes", "1", "--final-episodes", "2", "--log-dir", str(tmp_path),
+        "--env-kwargs", json.dumps({"max_episode_steps": 150}),
+        "--hyperparams", json.dumps({"n_steps": 4, "batch_size": 4, "n_epochs": 1}),
+    ]  # fmt: skip
+    run = train(parse_args(args))
+    config = yaml.safe_load((run / "config.yml").read_text())
+    assert config["warm_start"] == "clone" and config["env_wrapper"] == "agents.wrappers.PumpApex"
+    assert config["demo_seed"] == 5000 and config["demo_episodes"] == 2
+    from agents.imitation import Demonstrations
+
+    demonstrations = Demonstrations.load(run / "demonstrations.npz")
+    assert demonstrations.ended.sum() == 2  # two episodes
+    with np.load(run / "evaluations.npz") as log:
+        assert log["timesteps"][0] == 0  # the clone, evaluated before any update
+    scores = (run / "scores.md").read_text()
+    assert "held-out seeds 10000-10001" in scores
+    assert "| reference: lookahead | benchmarks/results/pump_response.md | 1 x 100 |" in scores
+    assert any(scores.count(w) for w in ("The trained agent wins", "The tuned heuristic wins", "No winner"))
+    assert "wall time: demonstrations" in scores and (run / "clip.gif").exists()
+
+
+def test_warm_start_clone_refuses_what_it_cannot_clone(tmp_path):
+    from agents.config import UsageError
+
+    runs = ["--log-dir", str(tmp_path / "runs")]
+    with pytest.raises(UsageError, match="--warm-start clone needs --algo ppo"):
+        train(parse_args(["--warm-start", "clone", "--algo", "sac", *runs]))
+    with pytest.raises(UsageError, match=r"seeds 9800\.\.10199 must lie in \[0, 10000\)"):
+        train(parse_args(["--warm-start", "clone", "--seed", "12", "--demo-episodes", "400", *runs]))
+    with pytest.raises(UsageError, match="--demo-episodes = 0 is invalid"):
+        train(parse_args(["--warm-start", "clone", "--demo-episodes", "0", *runs]))
+    assert not (tmp_path / "runs").exists()

@@ -32,3 +32,30 @@ def test_human_mode_shows_the_same_frame_in_a_window(monkeypatch):
     assert env.render() is None
     env.close()
     assert not pygame.display.get_init()
+
+
+def test_the_last_apex_shown_is_the_last_flight_apex_between_apexes():
+    """The overlay's "last apex" holds the height of the last flight apex over the steps after it
+    (the task's per-step apex height is 0 at every step without an apex)."""
+    from ballenv.controllers import PressurePump
+    from ballenv.envs.render import BallRenderer
+
+    env = gym.make("InflatedBall-v3", render_mode="rgb_array")
+    ball = env.unwrapped
+    pump = PressurePump(ball.observation_structure)
+    obs, _ = env.reset(seed=3)
+    start = obs[ball.observation_structure["last_apex"]][0]
+    assert f"last apex {start:.2f} m" in BallRenderer._labels(ball._batch, 0)[2]  # the start height
+    apexes = []
+    for _ in range(400):
+        obs, _, terminated, truncated, info = env.step(pump.act(obs))
+        if info["apex_count"]:
+            apexes.append(info["apex_height"])
+        elif apexes:  # a step after an apex, without one
+            break
+        assert not (terminated or truncated)
+    assert apexes and apexes[-1] > 0.3
+    label = BallRenderer._labels(ball._batch, 0)[2]
+    assert f"last apex {apexes[-1]:.2f} m" in label, label
+    assert env.render().shape == (SIZE, SIZE, 3)
+    env.close()

@@ -146,3 +146,49 @@ def test_vector_step_or_render_before_reset_asks_for_a_reset():
     obs, reward, *_ = venv.step(np.zeros((2, 1), dtype=np.float32))
     assert np.all(np.isfinite(obs)) and np.all((reward >= 0.0) & (reward <= 1.0))
     venv.close()
+
+
+def test_wrappers_and_vector_kwargs_go_to_sync_vectorisation_and_are_refused_by_the_native_env():
+    from gymnasium.error import Error
+    from gymnasium.vector import AutoresetMode, SyncVectorEnv
+    from gymnasium.wrappers import TransformReward
+
+    def halved(env):
+        return TransformReward(env, lambda r: 0.5 * r)
+
+    actions = _actions(40, 2, seed=4)
+    venv = gym.make_vec(
+        "InflatedBall-v3", num_envs=2, vectorization_mode="sync", wrappers=[halved],
+        vector_kwargs={"autoreset_mode": AutoresetMode.SAME_STEP},
+    )  # fmt: skip
+    assert isinstance(venv, SyncVectorEnv) and venv.metadata["autoreset_mode"] == AutoresetMode.SAME_STEP
+    assert all(isinstance(e, TransformReward) for e in venv.envs)
+    wrapped = _vector_rollouts(venv, 9, actions)
+    plain = _vector_rollouts(gym.make_vec("InflatedBall-v3", num_envs=2), 9, actions)  # native
+    np.testing.assert_allclose(wrapped[0], plain[0], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(wrapped[1], 0.5 * plain[1], rtol=1e-12)
+    # the default (native) mode: Gymnasium refuses both before the env is built
+    with pytest.raises(Error, match="wrappers argument"):
+        gym.make_vec("InflatedBall-v3", num_envs=2, wrappers=[halved])
+    with pytest.raises(Error, match="`vector_kwargs` is not empty"):
+        gym.make_vec("InflatedBall-v3", num_envs=2, vector_kwargs={"copy": False})
+    # and so does the native env's constructor, naming the mode that takes them
+    for name in ("wrappers", "vector_kwargs"):
+        with pytest.raises(TypeError, match=f"takes no '{name}': .*vectorization_mode=\"sync\""):
+            InflatedBallVectorEnv(num_envs=2, **{name: []})
+
+
+def test_the_native_vector_env_options_are_documented_in_its_module():
+    import inspect
+
+    import ballenv.envs.vector as vector
+    from ballenv.envs.inflated_ball import InflatedBallEnv
+
+    documented = InflatedBallVectorEnv.__doc__  # the API reference's (docs/api/envs.md)
+    assert "InflatedBallVectorEnv" in vector.__doc__
+    for name in inspect.signature(InflatedBallVectorEnv.__init__).parameters:
+        if name not in ("self", "kwargs"):
+            assert f"| {name} |" in documented, name
+    assert 'vectorization_mode="sync"' in documented
+    assert "## Vector Environments" in InflatedBallEnv.__doc__
+    assert 'vectorization_mode="sync"' in InflatedBallEnv.__doc__

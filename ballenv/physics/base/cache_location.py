@@ -4,8 +4,9 @@ numba keys a cached kernel on its own file only: after an edit or an upgrade tha
 in another file (a callee it inlined), the old machine code would still load and run. So the cache
 of ``ballenv`` lives in a folder named by a hash of every source file of the packages that hold
 kernels (``ballenv.physics``, ``ballenv.envs`` and ``ballenv.shell``), numba's version and Python's
-(:func:`source_key`): different code, a different folder, never a stale kernel, and checkouts of the
-same code share one cache. The folder sits under the first writable of ``NUMBA_CACHE_DIR`` (if set),
+(:func:`source_key`): different code, a different folder, never a stale kernel (two checkouts of the
+same code share the folder, not the kernels: numba names them by the source file's full path). The
+folder sits under the first writable of ``NUMBA_CACHE_DIR`` (if set),
 ``$XDG_CACHE_HOME/ballenv/numba`` (by default ``~/.cache/ballenv/numba``, 0700) and a private folder
 in the system's temporary directory (said once); with none writable, every run compiles (said once).
 Of the folders under the same parent, the ``KEEP`` most recently used are kept and older ones

@@ -9,7 +9,10 @@ and each compiles the same code (tens of seconds of CPU each, for the simulator'
 Python-called kernel (:func:`.jit.python_entry`) takes a lock file named after its source file, name
 and argument types (``filelock``: fcntl/msvcrt, released if the process dies) around numba's
 compilation, which looks in the disk cache again first, so a process that waited loads what the
-first one wrote. A process waiting says so (:func:`.compile_notice.log_info`).
+first one wrote. A process that waits longer than ``QUIET_WAIT`` says so (:func:`.compile_notice.log_info`),
+once: the first such wait of the process logs one line, later ones nothing (on a warm cache the
+lock is held only while another process loads a kernel, a fraction of a second, so workers that
+start together wait quietly; on an empty cache one line says why the process waits).
 
 The lock files live in a folder of the user's own (``$XDG_CACHE_HOME/ballenv/compile-locks``, by
 default ``~/.cache/ballenv/compile-locks``; ``BALLENV_LOCK_DIR`` overrides it), made with
@@ -31,6 +34,7 @@ from numba.core.registry import CPUDispatcher
 from .compile_notice import log_info
 
 WAIT_LIMIT = 900.0  # s: the longest wait for another process's compilation (a cold step: minutes)
+QUIET_WAIT = 3.0  # s: a wait this short is not reported (another process loading from the cache)
 WAITING = "waiting for another process compiling the simulator (%s); it then loads from the cache"
 GAVE_UP = "waited %.0f s for another process compiling the simulator (%s); compiling it here instead"
 
@@ -87,16 +91,24 @@ class SharedCompile(CPUDispatcher):
                 lock.release()
 
 
+_said_waiting = False  # whether this process has logged WAITING (it does so once)
+
+
 def _acquire(lock, name):
-    """Take ``lock`` at once, or after waiting for the process that holds it (saying so), at most
-    ``WAIT_LIMIT`` s; False if it is still held then (this process then compiles without it)."""
+    """Take ``lock`` within ``QUIET_WAIT`` s quietly, or after waiting longer for the process that
+    holds it (saying so, the first time in this process), at most ``WAIT_LIMIT`` s in all; False if
+    it is still held then (this process then compiles without it)."""
+    global _said_waiting
+    quiet = min(QUIET_WAIT, WAIT_LIMIT)
     try:
-        lock.acquire(timeout=0)
+        lock.acquire(timeout=quiet)
         return True
     except Timeout:
-        log_info(WAITING, name)
+        if not _said_waiting:
+            _said_waiting = True
+            log_info(WAITING, name)
     try:
-        lock.acquire(timeout=WAIT_LIMIT)
+        lock.acquire(timeout=WAIT_LIMIT - quiet)
         return True
     except Timeout:
         log_info(GAVE_UP, WAIT_LIMIT, name)

@@ -85,6 +85,7 @@ def test_a_stopped_holder_is_waited_for_at_most_the_limit_then_compiled_past(tmp
     caplog.set_level(logging.INFO, logger="ballenv")
     monkeypatch.setenv("BALLENV_LOCK_DIR", str(tmp_path / "locks"))
     monkeypatch.setattr(compile_lock, "WAIT_LIMIT", 0.5)
+    monkeypatch.setattr(compile_lock, "_said_waiting", False)  # as in a new process
     twin = jit.python_entry(jit.kernel(_scaled))
     assert private_dir(compile_lock.lock_dir())
     path = compile_lock.lock_path(twin, (types.float64,))
@@ -104,3 +105,59 @@ def test_a_stopped_holder_is_waited_for_at_most_the_limit_then_compiled_past(tmp
 
 def _scaled(x):
     return 3.0 * x
+
+
+HOLD_FOR = """
+import sys, time
+from filelock import FileLock
+locks = [FileLock(path) for path in sys.argv[2:]]
+for lock in locks:
+    lock.acquire()
+print("held", flush=True)
+for lock in locks:  # released one after the other, each after the time given
+    time.sleep(float(sys.argv[1]))
+    lock.release()
+"""
+
+
+def _waits_for(tmp_path, monkeypatch, caplog, seconds, kernels):
+    """Call each of ``kernels`` (new twins) while another process holds their locks, releasing one
+    every ``seconds``; the log's "waiting" lines."""
+    caplog.set_level(logging.INFO, logger="ballenv")
+    monkeypatch.setenv("BALLENV_LOCK_DIR", str(tmp_path / "locks"))
+    monkeypatch.setattr(compile_lock, "_said_waiting", False)  # as in a new process
+    twins = [jit.python_entry(jit.kernel(k)) for k in kernels]
+    assert private_dir(compile_lock.lock_dir())
+    paths = [compile_lock.lock_path(t, (types.float64,)) for t in twins]
+    command = [sys.executable, "-c", HOLD_FOR, str(seconds), *paths]
+    holder = subprocess.Popen(command, stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline().strip() == "held"
+        assert [t(2.0) for t in twins] == [k(2.0) for k in kernels]
+    finally:
+        holder.kill()
+        holder.wait()
+    return [line for line in caplog.text.splitlines() if "waiting for another process" in line]
+
+
+def test_a_process_says_it_waits_once_however_many_kernels_it_waits_for(tmp_path, monkeypatch, caplog):
+    monkeypatch.setattr(compile_lock, "QUIET_WAIT", 0.2)
+    lines = _waits_for(tmp_path, monkeypatch, caplog, 1.0, [_doubled, _halved])  # each waits ~1 s
+    assert len(lines) == 1 and "(_doubled)" in lines[0], lines
+
+
+def test_a_short_wait_for_a_process_loading_from_the_cache_is_not_reported(tmp_path, monkeypatch, caplog):
+    monkeypatch.setattr(compile_lock, "QUIET_WAIT", 30.0)
+    assert _waits_for(tmp_path, monkeypatch, caplog, 0.5, [_negated]) == []
+
+
+def _doubled(x):
+    return 2.0 * x
+
+
+def _halved(x):
+    return 0.5 * x
+
+
+def _negated(x):
+    return -x
