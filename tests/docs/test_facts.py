@@ -131,6 +131,15 @@ FACTS = {
             agents(hooks, "Paddle mode", "scripted dribble"),
         ],
     ),
+    "make train's scores": (
+        "README.md",
+        r"\| `make train`: [^|]*\| ([\d.]+) against ([\d.]+) \| [^|]*, (\d+) s on 2 cores [^|]*\|",
+        lambda hooks: [
+            results_cell(hooks, "make_train.md", ("ppo",), "apex error mean [95 % CI]"),
+            results_cell(hooks, "make_train.md", ("heuristic",), "apex error mean [95 % CI]"),
+            results_text("make_train.md", r"\*\*(\d+) s\*\* wall")[0],
+        ],
+    ),
     "soak under error control": (
         "docs/simulator.md",
         r"The soak's ([\d,]+) random hard\s+scenes under the default's `rtol` reach their end in ([\d,]+)"
