@@ -131,7 +131,7 @@ print(len(jit.python_entry(polygon_area).stats.cache_hits))
 def test_a_read_only_install_runs_its_shipped_kernels_without_compiling(tmp_path):
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "install"), XDG_CACHE_HOME=str(tmp_path / "home"))
     build = subprocess.run([sys.executable, "-c", AREA], env=env, capture_output=True, text=True, timeout=300)
-    assert build.returncode == 0 and "compiled polygon_area" in build.stderr, build.stderr[-2000:]
+    assert build.returncode == 0 and "compiling the simulator" in build.stderr, build.stderr[-2000:]
     shipped = tmp_path / "install" / cache_location.source_key()
     run = [sys.executable, "-c", READ_ONLY, str(shipped)]
     second = subprocess.run(run, env=env, capture_output=True, text=True, timeout=300)

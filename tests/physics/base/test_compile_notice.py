@@ -9,6 +9,7 @@ import sys
 import numba
 
 import ballenv.physics  # noqa: F401  (installs the notice)
+from ballenv.physics.base import compile_notice
 
 ROOT = pathlib.Path(__file__).resolve().parents[3]
 NOTICE_LOGGER = "ballenv.physics.base.compile_notice"
@@ -24,19 +25,19 @@ def _fresh_kernel(module):
     return numba.njit(add_one)
 
 
-def test_a_compile_of_ballenv_code_is_logged_at_info(caplog):
+def test_compiles_of_ballenv_code_give_one_notice_and_one_tally(caplog):
+    listener = compile_notice._LISTENER
+    listener.summary()  # (a tally of earlier tests' compiles, if any)
     caplog.set_level(logging.INFO, logger="ballenv")
     assert _fresh_kernel("ballenv.physics.example")(1.0) == 2.0
+    assert _fresh_kernel("ballenv.physics.other")(2.0) == 3.0
     records = [(r.name, r.levelno, r.getMessage()) for r in caplog.records]
-    assert records[0] == (
-        NOTICE_LOGGER,
-        logging.INFO,
-        "compiling the simulator with numba (add_one); once per install, up to a few minutes; "
-        "later runs load it from the cache",
-    )
-    assert records[1][:2] == (NOTICE_LOGGER, logging.INFO)
-    assert records[1][2].startswith("compiled add_one in ") and records[1][2].endswith(" s")
-    assert len(records) == 2
+    assert records == [(NOTICE_LOGGER, logging.INFO, compile_notice.NOTICE)]  # one line for both
+    assert listener.kernels == 2 and listener.spent > 0.0
+    caplog.clear()
+    listener.summary()  # (what the process does at exit)
+    (line,) = [r.getMessage() for r in caplog.records]
+    assert line.startswith("compiled the simulator in ") and "(2 kernels)" in line
 
 
 def test_other_compiles_and_levels_above_info_log_nothing(caplog):
@@ -68,11 +69,14 @@ def test_a_new_user_sees_it_on_stderr_and_a_configured_application_decides():
     # no logging configured: "ballenv: ..." lines on stderr (at INFO, where logging's last resort
     # would show only warnings)
     lines = _stderr_of("")
-    assert lines[0].startswith("ballenv: compiling the simulator with numba (add_one); once per install")
-    assert lines[1].startswith("ballenv: compiled add_one in ")
-    # configured at INFO: once, through the application's handler and format
+    assert lines[0] == "ballenv: " + compile_notice.NOTICE
+    assert lines[1].startswith("ballenv: compiled the simulator in ") and lines[1].endswith(
+        "(1 kernel); later runs load it from the cache"
+    )  # at exit
+    assert len(lines) == 2
+    # configured at INFO: through the application's handler and format
     lines = _stderr_of("import logging; logging.basicConfig(level=logging.INFO)\n")
-    assert lines[0].startswith(f"INFO:{NOTICE_LOGGER}:compiling the simulator with numba (add_one)")
+    assert lines[0].startswith(f"INFO:{NOTICE_LOGGER}:compiling the simulator with numba")
     assert len([line for line in lines if "compil" in line]) == 2
     # configured at WARNING (basicConfig's default), or ballenv's logger silenced: nothing
     assert _stderr_of("import logging; logging.basicConfig()\n") == []
