@@ -12,8 +12,24 @@ from ..physics.base.compile_notice import install as _install_compile_notice
 from .equilibrium import Equilibrium, EquilibriumError, equilibrium
 from .mesh import Mesh, icosphere
 from .modes import Modes, modes
-from .scene import Shell
+from .scene import Ground, Scene, Shell
+from .simulation import SimulationError, SimulationStats, Trajectory, simulate
 
-__all__ = ["Equilibrium", "EquilibriumError", "Mesh", "Modes", "Shell", "equilibrium", "icosphere", "modes"]
+__all__ = [
+    "Equilibrium",
+    "EquilibriumError",
+    "Ground",
+    "Mesh",
+    "Modes",
+    "Scene",
+    "Shell",
+    "SimulationError",
+    "SimulationStats",
+    "Trajectory",
+    "equilibrium",
+    "icosphere",
+    "modes",
+    "simulate",
+]
 
 _install_compile_notice()
