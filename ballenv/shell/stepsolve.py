@@ -5,9 +5,11 @@ faster than the envelope factorisation at ``h = 1e-4 s``).
 The matrix (N/m) is ``A = sum_e K_e + blocks + diag(D) + s u u^T - d W^T W``: element matrices
 (triangles, hinges), 3 x 3 vertex blocks (grounds' barriers, friction), a diagonal (the mass term),
 the gas's rank-one term (``s`` Pa/m^3, ``u = dV/dx``) and the damping's rank-6 term (``d`` 1/s^2
-times ``W`` of damping.py). The vertex blocks are added to the diagonal block of one triangle of
-each vertex (exact). Jacobi-preconditioned CG applies it element by element (:func:`pcg`); if it
-does not reach ``|r| <= rtol |b|`` within ``max_iter`` iterations, the envelope Cholesky with
+times ``W`` of damping.py); every degree of freedom is free (a step fixes none). The vertex blocks
+are added to the diagonal block of one triangle of each vertex (exact). Jacobi-preconditioned CG
+applies it element by element (:func:`pcg`) to a residual of ``CG_RTOL`` of the right-hand side
+(an inexact Newton direction: Newton's own test on the gradient sets the accuracy); if it does
+not get there within ``CG_MAX_ITER`` iterations, the envelope Cholesky with
 Sherman-Morrison solves the matrix without the rank-6 term (still symmetric positive definite, so
 Newton's direction stays one of descent).
 """
@@ -17,9 +19,9 @@ from numpy.typing import NDArray
 
 from ..physics.base.jit import kernel
 from . import envelope
-from .cg import _dot, apply, matrix_diagonal
+from .cg import _dot, matrix_diagonal
 
-CG_RTOL = 1e-8
+CG_RTOL = 1e-5
 CG_MAX_ITER = 400
 
 
@@ -46,21 +48,50 @@ def fold_blocks(tri_mats, owner_tri, owner_corner, blocks):
                 tri_mats[t, c + a, c + b] += blocks[v, a, b]
 
 
+@kernel(fastmath=True)
+def _apply_elements(elements, mats, x, y, local):
+    """``y += sum_e K_e x_e`` with every degree of freedom free; ``local`` (12,) scratch."""
+    n = 3 * elements.shape[1]
+    for e in range(elements.shape[0]):
+        for i in range(n):
+            local[i] = x[elements[e, i // 3], i % 3]
+        for i in range(n):
+            s = 0.0
+            for j in range(n):
+                s += mats[e, i, j] * local[j]
+            y[elements[e, i // 3], i % 3] += s
+
+
 @kernel
-def _low_rank(d, w, x, y, free, sign):
-    """``y += sign d W^T W x`` over the free entries."""
+def _apply(triangles, tri_mats, hinges, hinge_mats, diagonal, s, u, d, w, x, y, local):
+    """``y = A x`` (module doc) with every degree of freedom free."""
+    ux = 0.0
+    for v in range(x.shape[0]):
+        for c in range(3):
+            y[v, c] = diagonal[v, c] * x[v, c]
+            ux += u[v, c] * x[v, c]
+    _apply_elements(triangles, tri_mats, x, y, local)
+    _apply_elements(hinges, hinge_mats, x, y, local)
+    for v in range(x.shape[0]):
+        for c in range(3):
+            y[v, c] += s * ux * u[v, c]
     for k in range(w.shape[0]):
-        wx = _dot(w[k], x, free)
+        wx = 0.0
         for v in range(x.shape[0]):
             for c in range(3):
-                if free[v, c]:
-                    y[v, c] += sign * d * wx * w[k, v, c]
+                wx += w[k, v, c] * x[v, c]
+        for v in range(x.shape[0]):
+            for c in range(3):
+                y[v, c] -= d * wx * w[k, v, c]
 
 
 @kernel
-def pcg(triangles, tri_mats, hinges, hinge_mats, diagonal, s, u, d, w, free, rhs, x, work, rtol, max_iter):
-    """Jacobi-preconditioned CG on ``A x = rhs`` (module doc) from ``x = 0``; ``work`` (4, V, 3)
-    scratch. Returns the iterations taken, or -1 if ``max_iter`` was reached first."""
+def pcg(
+    triangles, tri_mats, hinges, hinge_mats, diagonal, s, u, d, w, free, rhs, x, work, local, rtol, max_iter
+):
+    """Jacobi-preconditioned CG on ``A x = rhs`` (module doc) from ``x = 0``, every degree of
+    freedom free; ``work`` (4, V, 3) and ``local`` (12,) scratch. Returns the iterations taken, or
+    -1 if ``max_iter`` was reached first."""
     r, p, q, dinv = work[0], work[1], work[2], work[3]
     matrix_diagonal(triangles, tri_mats, hinges, hinge_mats, diagonal, s, u, dinv)
     for k in range(w.shape[0]):
@@ -78,8 +109,7 @@ def pcg(triangles, tri_mats, hinges, hinge_mats, diagonal, s, u, d, w, free, rhs
     for it in range(max_iter):
         if np.sqrt(_dot(r, r, free)) <= goal:
             return it
-        apply(triangles, tri_mats, hinges, hinge_mats, diagonal, s, u, free, p, q)
-        _low_rank(d, w, p, q, free, -1.0)
+        _apply(triangles, tri_mats, hinges, hinge_mats, diagonal, s, u, d, w, p, q, local)
         alpha = rz / _dot(p, q, free)
         rz_new = 0.0
         for v in range(x.shape[0]):
@@ -116,7 +146,7 @@ def solve(problem, s, diagonal, d, w, rhs, work):
         out,
         work,
     )
-    iterations = pcg(*args, CG_RTOL, CG_MAX_ITER)
+    iterations = pcg(*args, np.zeros(12), CG_RTOL, CG_MAX_ITER)
     if iterations >= 0:
         return out, iterations
     envelope.assemble(problem.env, m.triangles, ws.tri_hess, m.hinges, ws.hinge_hess, diagonal, free)

@@ -52,7 +52,7 @@ def test_frictionless_sliding_down_a_slope_accelerates_at_g_sin_theta():
     theta = 0.2
     normal = (-np.sin(theta), 0.0, np.cos(theta))
     ball = Shell(subdivisions=2, position=tuple(0.1288 * np.array(normal)))
-    scene = Scene(shells=[ball], grounds=[Ground(normal=normal)], rtol=1e-3)
+    scene = Scene(shells=[ball], grounds=[Ground(normal=normal)], rtol=1e-3, newton_tol=1e-12)
     traj = simulate(scene, t_end=0.1, output_dt=0.01)
     c, _ = centres(traj, ball)
     downhill = -np.array([np.cos(theta), 0.0, np.sin(theta)])
