@@ -27,10 +27,11 @@ def apex_fraction(z0: float, z1: float, d0: float, d1: float) -> float:
     a = 6.0 * (z0 - z1) + 3.0 * d0 + 3.0 * d1
     b = -6.0 * (z0 - z1) - 4.0 * d0 - 2.0 * d1
     c = d0
-    if abs(a) < 1e-14 * (abs(b) + abs(c)):
-        return min(max(-c / b, 0.0), 1.0)
     disc = math.sqrt(max(b * b - 4.0 * a * c, 0.0))
-    roots = [(-b - disc) / (2.0 * a), (-b + disc) / (2.0 * a)]
+    q = -0.5 * (b + math.copysign(disc, b))  # the roots q / a and c / q without cancellation
+    roots = [c / q] if q != 0.0 else []
+    if a != 0.0:
+        roots.append(q / a)
     inside = [r for r in roots if -1e-12 <= r <= 1.0 + 1e-12]
     return min(max(min(inside) if inside else 1.0, 0.0), 1.0)
 

@@ -132,3 +132,15 @@ def test_a_shell_rolls_down_a_slope_at_three_fifths_of_g_sin_theta():
         mass * (r[:, 0] ** 2 + r[:, 2] ** 2)
     )
     assert spin * c[-1, 2] == pytest.approx(v[-1, 0], rel=0.02)  # no slip: omega r = v
+
+
+def test_the_apex_of_a_throw_is_located_inside_its_step_exactly():
+    ball = Shell(subdivisions=1, position=(0, 0, 1.0), velocity=(0.5, 0, 2.0))
+    scene = Scene(shells=[ball], dt=7e-3, adaptive=False)
+    traj = simulate(scene, t_end=0.3)
+    c, _ = centres(traj, ball)
+    ((t_apex, z_apex),) = traj.apexes()
+    assert not np.any(np.isclose(traj.t, t_apex, rtol=0, atol=1e-4))  # inside a step, not at its end
+    # generalized-alpha follows the parabola exactly, and the cubic Hermite through it is exact
+    assert t_apex == pytest.approx(2.0 / G, abs=1e-12)
+    assert z_apex == pytest.approx(c[0, 2] + 2.0**2 / (2 * G), abs=1e-12)
