@@ -185,6 +185,48 @@ def next_step(scene: Scene, method: implicit.Integrator, h: float, ratio: float)
     return min(scene.dt, h * grow)
 
 
+class Run:
+    """A run's state between steps: positions, velocities, accelerations and contact forces
+    (shells, V, 3), and what it has recorded."""
+
+    def __init__(self, scene: Scene, x0: ArrayLike | None, v0: ArrayLike | None, output_dt: float | None):
+        self.scene = scene
+        self.method, self.steps = build(scene)
+        self.x, self.v = initial_states(scene, x0, v0)
+        self.a = np.array(
+            [implicit.initial_acceleration(st, self.x[k], self.v[k]) for k, st in enumerate(self.steps)]
+        )
+        self.force = np.zeros_like(self.x)
+        g = np.array(scene.gravity_vector)
+        self.up = -g / np.linalg.norm(g) if np.linalg.norm(g) > 0.0 else np.array([0.0, 0.0, 1.0])
+        self.recorder, self.stats = Recorder(output_dt, self.steps), SimulationStats()
+        self.events: list[tuple[float, int, str, float]] = []
+        self.recorder.add(0.0, self.x, self.v, self.force)
+
+    def accept(self, t: float, h: float, results: list[implicit.StepResult]) -> None:
+        """Takes the step ``[t, t + h]``: its events, records and work."""
+        x1, v1 = np.array([r.x for r in results]), np.array([r.v for r in results])
+        f1 = np.array([r.contact_force for r in results])
+        for k, st in enumerate(self.steps):
+            d0 = ground.min_distance(self.x[k], st.normals, st.heights)
+            d1 = ground.min_distance(x1[k], st.normals, st.heights)
+            ends = (self.x[k], self.v[k], d0), (x1[k], v1[k], d1)
+            self.events += events.detect(t, h, k, self.up, st.problem.model.mass, *ends, st.dhat)
+        self.recorder.step(t, h, (self.x, self.v, self.force), (x1, v1, f1))
+        self.stats.steps += 1
+        self.stats.newton_iterations += sum(r.iterations for r in results)
+        self.stats.cg_iterations += sum(r.cg_iterations for r in results)
+        self.stats.envelope_solves += sum(r.envelope_solves for r in results)
+        self.x, self.v, self.a, self.force = x1, v1, np.array([r.a for r in results]), f1
+
+    def reject(self, t: float, h: float, why: str) -> float:
+        """Counts a rejected step; returns ``h`` (s), the next try, unless below ``dt_min``."""
+        self.stats.rejections += 1
+        if h < self.scene.dt_min:
+            raise SimulationError(f"{why} below dt_min = {self.scene.dt_min:g} s at t = {t:.6g} s")
+        return h
+
+
 def simulate(
     scene: Scene,
     t_end: float,
@@ -199,52 +241,24 @@ def simulate(
         raise ValueError(
             f"output_dt = {output_dt!r} is out of range: must be None or a number in (0, t_end] s"
         )
-    method, steps = build(scene)
-    x, v = initial_states(scene, x0, v0)
-    a = np.array([implicit.initial_acceleration(st, x[k], v[k]) for k, st in enumerate(steps)])
-    force = np.zeros_like(x)
-    up = -np.array(scene.gravity_vector) / (np.linalg.norm(scene.gravity_vector) or 1.0)
-    up = up if np.linalg.norm(scene.gravity_vector) > 0.0 else np.array([0.0, 0.0, 1.0])
-    recorder, stats, found = Recorder(output_dt, steps), SimulationStats(), []
-    recorder.add(0.0, x, v, force)
+    run = Run(scene, x0, v0, output_dt)
+    method, q = run.method, integrator.error_exponent(run.method.solver)
     t, h, clock = 0.0, scene.dt, time.perf_counter()
     while t < t_end * (1.0 - 1e-12):
         trial = min(h, t_end - t)
         try:
-            results = try_step(method, steps, (x, v, a), trial)
+            results = try_step(method, run.steps, (run.x, run.v, run.a), trial)
         except implicit.StepFailure:
-            stats.rejections += 1
-            h = 0.5 * trial
-            if h < scene.dt_min:
-                raise SimulationError(
-                    f"the step was halved below dt_min = {scene.dt_min:g} s at t = {t:.6g} s"
-                ) from None
+            h = run.reject(t, 0.5 * trial, "the step was halved")
             continue
         a1 = np.array([r.a for r in results])
-        ratio = error_ratio(scene, method, steps, a, a1, trial) if scene.adaptive else 0.0
+        ratio = error_ratio(scene, method, run.steps, run.a, a1, trial) if scene.adaptive else 0.0
         if ratio > 1.0:
-            stats.rejections += 1
-            h = trial * max(SHRINK, 0.9 * ratio ** -integrator.error_exponent(method.solver))
-            if h < scene.dt_min:
-                raise SimulationError(
-                    f"the error control shrank the step below dt_min = {scene.dt_min:g} s at t = {t:.6g} s"
-                )
+            h = run.reject(t, trial * max(SHRINK, 0.9 * ratio**-q), "the error control shrank the step")
             continue
-        x1, v1 = np.array([r.x for r in results]), np.array([r.v for r in results])
-        f1 = np.array([r.contact_force for r in results])
-        for k, st in enumerate(steps):
-            d0 = ground.min_distance(x[k], st.normals, st.heights)
-            d1 = ground.min_distance(x1[k], st.normals, st.heights)
-            found += events.detect(
-                t, trial, k, up, st.problem.model.mass, (x[k], v[k], d0), (x1[k], v1[k], d1), st.dhat
-            )
-        recorder.step(t, trial, (x, v, force), (x1, v1, f1))
-        stats.steps += 1
-        stats.newton_iterations += sum(r.iterations for r in results)
-        stats.cg_iterations += sum(r.cg_iterations for r in results)
-        stats.envelope_solves += sum(r.envelope_solves for r in results)
-        x, v, a, force, t = x1, v1, a1, f1, t + trial
+        run.accept(t, trial, results)
+        t += trial
         h = next_step(scene, method, trial, ratio)
-    stats.wall_time = time.perf_counter() - clock
-    tt, xx, vv, ff, pp = recorder.arrays()
-    return Trajectory(tt, xx, vv, ff, pp, sorted(found), stats, scene)
+    run.stats.wall_time = time.perf_counter() - clock
+    tt, xx, vv, ff, pp = run.recorder.arrays()
+    return Trajectory(tt, xx, vv, ff, pp, sorted(run.events), run.stats, scene)
