@@ -144,3 +144,18 @@ def test_the_apex_of_a_throw_is_located_inside_its_step_exactly():
     # generalized-alpha follows the parabola exactly, and the cubic Hermite through it is exact
     assert t_apex == pytest.approx(2.0 / G, abs=1e-12)
     assert z_apex == pytest.approx(c[0, 2] + 2.0**2 / (2 * G), abs=1e-12)
+
+
+def test_a_shell_sliding_with_friction_decelerates_by_coulombs_mu_g_cos_theta():
+    """Below mu = 2/5 tan(theta) a ball slips all the way down: a = g (sin(theta) - mu cos(theta))
+    whatever its spin. Its hops on the coarse mesh's facets do not change it: friction's impulse is
+    mu times the normal impulse, which over time balances m g cos(theta)."""
+    theta, mu = 0.2, 0.05  # slips for mu < 2/5 tan(theta) = 0.081
+    normal = (-np.sin(theta), 0.0, np.cos(theta))
+    ball = Shell(subdivisions=2, position=tuple(0.1288 * np.array(normal)))
+    scene = Scene(shells=[ball], grounds=[Ground(normal=normal, friction=mu)], rtol=1e-3)
+    traj = simulate(scene, t_end=0.4, output_dt=0.01)
+    c, _ = centres(traj, ball)
+    downhill = -np.array([np.cos(theta), 0.0, np.sin(theta)])
+    a = 2 * np.polyfit(traj.t, c @ downhill, 2)[0]
+    assert a == pytest.approx(G * (np.sin(theta) - mu * np.cos(theta)), rel=0.01)  # measured +0.49 %
