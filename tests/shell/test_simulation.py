@@ -159,3 +159,17 @@ def test_a_shell_sliding_with_friction_decelerates_by_coulombs_mu_g_cos_theta():
     downhill = -np.array([np.cos(theta), 0.0, np.sin(theta)])
     a = 2 * np.polyfit(traj.t, c @ downhill, 2)[0]
     assert a == pytest.approx(G * (np.sin(theta) - mu * np.cos(theta)), rel=0.01)  # measured +0.49 %
+
+
+def test_two_shells_step_together_each_as_alone_and_bad_arguments_name_themselves():
+    a = Shell(subdivisions=1, position=(0, 0, 0.2), velocity=(0, 0, -1.0))
+    b = Shell(subdivisions=1, position=(1, 0, 0.5), angular_velocity=(0, 5.0, 0))
+    grounds = [Ground(friction=0.3)]
+    both = simulate(Scene(shells=[a, b], grounds=grounds, dt=1e-3, adaptive=False), t_end=0.05)
+    for k, shell in enumerate((a, b)):
+        alone = simulate(Scene(shells=[shell], grounds=grounds, dt=1e-3, adaptive=False), t_end=0.05)
+        assert np.array_equal(both.x[:, k], alone.x[:, 0]) and both.pressure.shape == (51, 2)
+    with pytest.raises(ValueError, match=r"t_end = -1 is out of range"):
+        simulate(Scene(shells=[a]), t_end=-1)
+    with pytest.raises(ValueError, match=r"x0 and v0 must be finite arrays of shape \(1, 42, 3\)"):
+        simulate(Scene(shells=[a]), t_end=0.1, v0=np.full((1, 42, 3), np.nan))
