@@ -2,18 +2,36 @@
 
 An icosphere mesh (mesh.py); St. Venant-Kirchhoff membrane triangles (membrane.py); discrete-shell
 hinge bending (bending.py); the enclosed gas (gas.py); their total potential (potential.py); the
-envelope Cholesky of its Hessian (envelope.py) and, for comparison, Jacobi-preconditioned CG
-(cg.py); static equilibrium (equilibrium.py), linear vibration modes (modes.py), and one implicit
-backward-Euler step (implicit.py) with gravity and a flat ground's contact barrier (ground.py).
-SI units.
+envelope Cholesky of its Hessian (envelope.py) and Jacobi-preconditioned CG (cg.py); static
+equilibrium (equilibrium.py) and linear vibration modes (modes.py). The dynamics: the validated
+descriptions ``Shell``, ``Ground``, ``Scene`` (scene.py); grounds' barriers (ground.py), lagged
+Coulomb friction (friction.py) and damping of the deformation only (damping.py); the implicit
+step, backward Euler or generalized-alpha (implicit.py) and its linear solve (stepsolve.py);
+events (events.py); ``simulate`` and ``Trajectory`` (simulation.py). SI units.
 """
 
 from ..physics.base.compile_notice import install as _install_compile_notice
 from .equilibrium import Equilibrium, EquilibriumError, equilibrium
 from .mesh import Mesh, icosphere
 from .modes import Modes, modes
-from .scene import Shell
+from .scene import Ground, Scene, Shell
+from .simulation import SimulationError, SimulationStats, Trajectory, simulate
 
-__all__ = ["Equilibrium", "EquilibriumError", "Mesh", "Modes", "Shell", "equilibrium", "icosphere", "modes"]
+__all__ = [
+    "Equilibrium",
+    "EquilibriumError",
+    "Ground",
+    "Mesh",
+    "Modes",
+    "Scene",
+    "Shell",
+    "SimulationError",
+    "SimulationStats",
+    "Trajectory",
+    "equilibrium",
+    "icosphere",
+    "modes",
+    "simulate",
+]
 
 _install_compile_notice()

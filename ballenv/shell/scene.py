@@ -1,4 +1,5 @@
-"""The description of one inflated shell ball, validated on construction (SI units).
+"""What to simulate, validated on construction (SI units): ``Shell`` (one inflated ball), ``Ground``
+(a half-space) and ``Scene`` (shells, grounds, effects and the numerical method).
 
 Every field is checked when the object is made; a bad value raises ``ValueError`` naming the field,
 the value and the valid range, e.g.::
@@ -7,11 +8,12 @@ the value and the valid range, e.g.::
 """
 
 import math
-from dataclasses import dataclass
+from collections.abc import Sequence
+from dataclasses import dataclass, field
 from numbers import Real
 from typing import Any
 
-from ..physics.scene import check_int, check_real, fail
+from ..physics.scene import check_choice, check_int, check_real, check_sequence, fail
 
 MAX_SUBDIVISIONS = 6  # 40962 vertices
 ATMOSPHERIC_PRESSURE = 101325.0  # Pa
@@ -89,3 +91,115 @@ class Shell:
         """Plate bending stiffness k_b = E h^3 / (12 (1 - nu^2)) (N m)."""
         nu = self.poisson_ratio
         return self.youngs_modulus * self.thickness**3 / (12.0 * (1.0 - nu * nu))
+
+
+@dataclass(frozen=True)
+class Ground:
+    """A fixed ground: the half-space ``n . x >= height`` of any orientation.
+
+    normal: the unit normal n into the free side (any non-zero 3-vector, normalised here);
+    height: the plane's offset (m) along n (the plane is ``n . x = height``); friction: the
+    Coulomb coefficient mu in [0, 10] (0: frictionless).
+    """
+
+    normal: tuple[float, float, float] = (0.0, 0.0, 1.0)
+    height: float = 0.0
+    friction: float = 0.0
+
+    def __post_init__(self) -> None:
+        n = check_vector3("Ground", "normal", self.normal, 1e6, "(not all zero)")
+        length = math.sqrt(sum(c * c for c in n))
+        if not length > 1e-12:
+            fail("Ground", "normal", self.normal, "a non-zero 3-vector")
+        object.__setattr__(self, "normal", (n[0] / length, n[1] / length, n[2] / length))
+        object.__setattr__(self, "height", check_real("Ground", "height", self.height, -1e6, 1e6, "m"))
+        object.__setattr__(self, "friction", check_real("Ground", "friction", self.friction, 0.0, 10.0))
+
+
+INTEGRATORS = ("generalized_alpha", "backward_euler")
+
+
+@dataclass(frozen=True)
+class Scene:
+    """Shells, grounds, the effects acting on them and the numerical method (SI units).
+
+    shells: one or more :class:`Shell` (they do not touch each other yet); grounds: any number of
+    :class:`Ground` half-spaces. gravity: g (m/s^2) along -z in [0, 1000], or a 3-vector (m/s^2).
+    damping: c (1/s) in [0, 1e6] of the deformation damping ``F_i = -c m_i (v_i - v_rigid,i)``,
+    ``v_rigid`` the mass-weighted least-squares rigid motion (translation plus spin about the
+    centre of mass) of the shell's velocities: flight, spin and rolling are not damped.
+    integrator: "generalized_alpha" (second order, default) or "backward_euler" (first order);
+    rho_infinity: generalized-alpha's spectral radius at infinite frequency in [0, 1] (1: the
+    trapezoidal rule, no numerical damping). dt: the largest (and first) step (s) in (0, 1];
+    dt_min: the smallest before ``simulate`` gives up, in (0, dt]. adaptive: the step follows the
+    local error estimate (at most ``rtol R`` m, RMS over the vertices, ``R`` the shell's radius);
+    False: fixed steps ``dt``, halved only on rejection. rtol in (0, 1]. gas_exponent gamma in
+    [0, 3] and atmospheric_pressure (Pa) in [0, 1e8] of the gas law. contact_distance: the
+    barrier's reach dhat (m) in (0, 1]; contact_stiffness: its kappa (N/m) in (0, 1e12], None:
+    each shell's ``E h``; friction_velocity: the slip speed eps_v (m/s) in (0, 10] below which
+    Coulomb friction is smoothed (sticking). newton_tol in [1e-14, 1e-2]: Newton stops when every
+    vertex's residual acceleration is below ``newton_tol (|g| + R / h^2)``; newton_max_iter in
+    [1, 200]: more and the step is rejected.
+    """
+
+    shells: Sequence[Shell] = field(default_factory=lambda: (Shell(),))
+    grounds: Sequence[Ground] = ()
+    gravity: float | tuple[float, float, float] = 9.81
+    damping: float = 0.0
+    integrator: str = "generalized_alpha"
+    rho_infinity: float = 0.9
+    dt: float = 2e-3
+    dt_min: float = 1e-8
+    adaptive: bool = True
+    rtol: float = 1e-4
+    gas_exponent: float = 1.0
+    atmospheric_pressure: float = ATMOSPHERIC_PRESSURE
+    contact_distance: float = 1e-3
+    contact_stiffness: float | None = None
+    friction_velocity: float = 1e-3
+    newton_tol: float = 1e-9
+    newton_max_iter: int = 30
+
+    def __post_init__(self) -> None:
+        o, s = "Scene", object.__setattr__
+        s(self, "shells", check_sequence(o, "shells", self.shells, Shell, allow_empty=False))
+        s(self, "grounds", check_sequence(o, "grounds", self.grounds, Ground, allow_empty=True))
+        if isinstance(self.gravity, Real) and not isinstance(self.gravity, bool):
+            s(self, "gravity", check_real(o, "gravity", self.gravity, 0.0, 1000.0, "m/s^2"))
+        else:
+            s(self, "gravity", check_vector3(o, "gravity", self.gravity, 1000.0, "m/s^2"))
+        s(self, "damping", check_real(o, "damping", self.damping, 0.0, 1e6, "1/s"))
+        s(self, "integrator", check_choice(o, "integrator", self.integrator, INTEGRATORS))
+        s(self, "rho_infinity", check_real(o, "rho_infinity", self.rho_infinity, 0.0, 1.0))
+        s(self, "dt", check_real(o, "dt", self.dt, 0.0, 1.0, "s", low_open=True))
+        s(self, "dt_min", check_real(o, "dt_min", self.dt_min, 0.0, self.dt, "s", low_open=True))
+        if not isinstance(self.adaptive, bool):
+            fail(o, "adaptive", self.adaptive, "True or False")
+        s(self, "rtol", check_real(o, "rtol", self.rtol, 0.0, 1.0, low_open=True))
+        s(self, "gas_exponent", check_real(o, "gas_exponent", self.gas_exponent, 0.0, 3.0))
+        atm = check_real(o, "atmospheric_pressure", self.atmospheric_pressure, 0.0, 1e8, "Pa")
+        s(self, "atmospheric_pressure", atm)
+        s(
+            self,
+            "contact_distance",
+            check_real(o, "contact_distance", self.contact_distance, 0.0, 1.0, "m", True),
+        )
+        if self.contact_stiffness is not None:
+            kappa = check_real(o, "contact_stiffness", self.contact_stiffness, 0.0, 1e12, "N/m", True)
+            s(self, "contact_stiffness", kappa)
+        s(
+            self,
+            "friction_velocity",
+            check_real(o, "friction_velocity", self.friction_velocity, 0.0, 10.0, "m/s", True),
+        )
+        s(self, "newton_tol", check_real(o, "newton_tol", self.newton_tol, 1e-14, 1e-2))
+        s(self, "newton_max_iter", check_int(o, "newton_max_iter", self.newton_max_iter, 1, 200))
+        for k, shell in enumerate(self.shells):
+            if shell.pressure + atm <= 0.0:
+                fail(o, f"shells[{k}].pressure", shell.pressure, f"above -atmospheric_pressure ({atm:g} Pa)")
+
+    @property
+    def gravity_vector(self) -> tuple[float, float, float]:
+        """Gravity's acceleration (m/s^2) as a 3-vector."""
+        g = self.gravity
+        return (0.0, 0.0, -float(g)) if isinstance(g, float) else g

@@ -36,3 +36,52 @@ def test_a_bad_field_names_itself_its_value_and_its_range(field, value, words):
     with pytest.raises(ValueError) as error:
         Shell(**{field: value})
     assert words in str(error.value)
+
+
+def test_a_ground_normalises_its_normal_and_a_scene_its_gravity():
+    from ballenv.shell import Ground, Scene
+
+    assert Ground(normal=(0, 3, 4)).normal == pytest.approx((0.0, 0.6, 0.8))
+    assert Scene().gravity_vector == (0.0, 0.0, -9.81)
+    assert Scene(gravity=(1, 2, -3)).gravity_vector == (1.0, 2.0, -3.0)
+
+
+@pytest.mark.parametrize(
+    "owner, field, value, words",
+    [
+        (
+            "Ground",
+            "normal",
+            (0, 0, 0),
+            "Ground.normal = (0, 0, 0) is out of range: must be a non-zero 3-vector",
+        ),
+        (
+            "Ground",
+            "friction",
+            -0.1,
+            "Ground.friction = -0.1 is out of range: must be a finite number in [0, 10]",
+        ),
+        ("Ground", "height", math.nan, "Ground.height"),
+        ("Scene", "shells", (), "Scene.shells = () is out of range: must be a non-empty sequence of Shell"),
+        (
+            "Scene",
+            "gravity",
+            -1.0,
+            "Scene.gravity = -1.0 is out of range: must be a finite number in [0, 1000]",
+        ),
+        ("Scene", "damping", -1.0, "Scene.damping"),
+        ("Scene", "integrator", "rk4", "one of 'generalized_alpha', 'backward_euler'"),
+        ("Scene", "dt", 0.0, "Scene.dt = 0.0 is out of range: must be a finite number in (0, 1] s"),
+        ("Scene", "dt_min", 1.0, "Scene.dt_min = 1.0 is out of range"),
+        ("Scene", "rtol", 0.0, "Scene.rtol"),
+        ("Scene", "adaptive", 1, "Scene.adaptive = 1 is out of range: must be True or False"),
+        ("Scene", "newton_max_iter", 0, "an integer in [1, 200]"),
+        ("Scene", "contact_distance", 0.0, "Scene.contact_distance"),
+    ],
+)
+def test_a_bad_ground_or_scene_field_names_itself_its_value_and_its_range(owner, field, value, words):
+    from ballenv.shell import Ground, Scene
+
+    with pytest.raises(ValueError) as error:
+        {"Ground": Ground, "Scene": Scene}[owner](**{field: value})
+    assert words in str(error.value)

@@ -1,0 +1,264 @@
+"""``simulate(scene, t_end)``: shells under their gas, gravity, damping, grounds and friction,
+advanced by implicit steps (implicit.py), recorded in a :class:`Trajectory` (SI units).
+
+Each shell starts from its inflated equilibrium (equilibrium.py) centred at its ``position``, or
+from ``x0``, with the velocity ``velocity + angular_velocity x (x - centre)`` or ``v0``. All
+shells take the same steps. Step control: a step whose Newton iteration fails for any shell is
+rejected (never accepted) and retried with half the step; below ``dt_min`` ``simulate`` raises
+:class:`SimulationError`. With ``adaptive``, the local error estimate of the ring's integrators
+(``ballenv.physics.step.integrator``), ``e_i = c h^2 (a1_i - w a0_i)`` (m; generalized-alpha
+``c = beta - 1/6``, ``w = 1``; backward Euler ``c = 1/2``, ``w = 0``), must have an RMS over each
+shell's vertices of at most ``rtol R``: a larger one rejects the step, and the next step is
+``h min(1.25, max(0.2, 0.9 (rtol R / e)^q))`` (``q`` 1/3 or 1/2), at most ``dt``. Without it,
+steps are ``dt``, and a halved step doubles back after each accepted step. Records are every
+accepted step, or, with ``output_dt``, at its multiples, interpolated inside the steps (cubic
+Hermite positions and their derivative; contact forces linearly), which never changes the steps.
+"""
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ..physics.step import integrator
+from . import events, ground, implicit
+from .equilibrium import equilibrium
+from .gas import gauge_pressure, volume
+from .model import build_model
+from .scene import Scene
+
+F64 = NDArray[np.float64]
+SHRINK = 0.2  # smallest factor of an adaptive step's change
+
+
+class SimulationError(RuntimeError):
+    """The step was halved below ``Scene.dt_min`` without an accepted step."""
+
+
+@dataclass
+class SimulationStats:
+    """steps: accepted; rejections; newton_iterations, cg_iterations and envelope_solves (the CG
+    fallback) summed over shells and accepted steps; wall_time (s) of the stepping."""
+
+    steps: int = 0
+    rejections: int = 0
+    newton_iterations: int = 0
+    cg_iterations: int = 0
+    envelope_solves: int = 0
+    wall_time: float = 0.0
+
+
+@dataclass
+class Trajectory:
+    """t (T,) s; x, v (T, shells, V, 3) m, m/s; contact_force (T, shells, V, 3) N, the grounds'
+    barrier and friction force; pressure (T, shells) Pa gauge; events: ``(t s, shell, kind,
+    centre-of-mass height m)`` with kind "apex", "touchdown" or "liftoff"; stats."""
+
+    t: F64
+    x: F64
+    v: F64
+    contact_force: F64
+    pressure: F64
+    events: list[tuple[float, int, str, float]]
+    stats: SimulationStats
+    scene: Scene = field(repr=False)
+
+    def apexes(self, shell: int = 0) -> F64:
+        """(k, 2): (t s, centre-of-mass height m) of each apex of ``shell``, located in its step."""
+        rows = [(t, z) for t, k, kind, z in self.events if k == shell and kind == "apex"]
+        return np.array(rows, dtype=np.float64).reshape(-1, 2)
+
+
+def build(scene: Scene) -> tuple[implicit.Integrator, list[implicit.ShellStep]]:
+    """The integrator and each shell's step data."""
+    method = implicit.make_integrator(
+        scene.integrator, scene.rho_infinity, scene.newton_tol, scene.newton_max_iter, scene.dt
+    )
+    g = np.array(scene.gravity_vector)
+    normals = np.array([gr.normal for gr in scene.grounds], dtype=np.float64).reshape(-1, 3)
+    heights = np.array([gr.height for gr in scene.grounds], dtype=np.float64)
+    mu = np.array([gr.friction for gr in scene.grounds], dtype=np.float64)
+    steps = []
+    for shell in scene.shells:
+        model = build_model(shell, scene.gas_exponent, scene.atmospheric_pressure)
+        kappa = scene.contact_stiffness or shell.youngs_modulus * shell.thickness
+        contact = (scene.contact_distance, kappa, scene.friction_velocity)
+        steps.append(implicit.make_step(model, g, (normals, heights, mu), contact, scene.damping))
+    return method, steps
+
+
+def initial_states(scene: Scene, x0: ArrayLike | None, v0: ArrayLike | None) -> tuple[F64, F64]:
+    """Positions and velocities (shells, V, 3) at t = 0 (module doc)."""
+    n = [s.n_vertices for s in scene.shells]
+    if len(set(n)) != 1:
+        raise ValueError(f"Scene.shells must all have the same subdivisions (vertex counts {n})")
+    shape = (len(n), n[0], 3)
+    xs, vs = np.zeros(shape), np.zeros(shape)
+    if x0 is not None:
+        xs[:] = np.asarray(x0, dtype=np.float64).reshape(shape)
+    for k, shell in enumerate(scene.shells):
+        model = build_model(shell, scene.gas_exponent, scene.atmospheric_pressure)
+        if x0 is None:
+            x = equilibrium(
+                shell, gas_exponent=scene.gas_exponent, atmospheric_pressure=scene.atmospheric_pressure
+            ).x
+            xs[k] = x - events.centre(model.mass, x) + np.array(shell.position)
+        spin = np.cross(np.array(shell.angular_velocity), xs[k] - events.centre(model.mass, xs[k]))
+        vs[k] = np.array(shell.velocity) + spin
+    if v0 is not None:
+        vs[:] = np.asarray(v0, dtype=np.float64).reshape(shape)
+    if not (np.all(np.isfinite(xs)) and np.all(np.isfinite(vs))):
+        raise ValueError(f"x0 and v0 must be finite arrays of shape {shape} (m, m/s)")
+    return xs, vs
+
+
+class Recorder:
+    """The records of a run: every accepted step's end, or the multiples of ``output_dt``."""
+
+    def __init__(self, output_dt: float | None, steps: list[implicit.ShellStep]) -> None:
+        self.output_dt, self.steps = output_dt, steps
+        self.rows: list[tuple[float, F64, F64, F64, F64]] = []
+        self.count = 0
+
+    def add(self, t: float, x: F64, v: F64, force: F64) -> None:
+        """One record at ``t`` (s)."""
+        p = [
+            gauge_pressure(st.problem.model, volume(x[k], st.problem.model.triangles))
+            for k, st in enumerate(self.steps)
+        ]
+        self.rows.append((t, x.copy(), v.copy(), force.copy(), np.array(p, dtype=np.float64)))
+        self.count += 1
+
+    def step(self, t: float, h: float, before: tuple[F64, F64, F64], after: tuple[F64, F64, F64]) -> None:
+        """Records for the accepted step ``[t, t + h]`` from its ends' ``(x, v, contact force)``."""
+        if self.output_dt is None:
+            self.add(t + h, *after)
+            return
+        while self.count * self.output_dt <= t + h * (1.0 + 1e-12):
+            s = min(max((self.count * self.output_dt - t) / h, 0.0), 1.0)
+            (x0, v0, f0), (x1, v1, f1) = before, after
+            s2, s3 = s * s, s * s * s
+            x = (
+                (2 * s3 - 3 * s2 + 1) * x0
+                + (s3 - 2 * s2 + s) * h * v0
+                + (3 * s2 - 2 * s3) * x1
+                + (s3 - s2) * h * v1
+            )
+            v = (6 * s2 - 6 * s) * (x0 - x1) / h + (3 * s2 - 4 * s + 1) * v0 + (3 * s2 - 2 * s) * v1
+            self.add(self.count * self.output_dt, x, v, (1.0 - s) * f0 + s * f1)
+
+    def arrays(self) -> tuple[F64, F64, F64, F64, F64]:
+        """``(t, x, v, contact_force, pressure)`` stacked."""
+        return tuple(np.array([row[k] for row in self.rows]) for k in range(5))  # type: ignore[return-value]
+
+
+def error_ratio(
+    scene: Scene, method: implicit.Integrator, steps: list[implicit.ShellStep], a0: F64, a1: F64, h: float
+) -> float:
+    """The largest over shells of ``RMS_i |e_i| / (rtol R)`` (module doc)."""
+    c = integrator.error_coefficient(method.solver)
+    w = integrator.error_start_weight(method.solver)
+    worst = 0.0
+    for k, st in enumerate(steps):
+        e = c * h * h * (a1[k] - w * a0[k])
+        worst = max(worst, float(np.sqrt(np.mean(np.sum(e * e, axis=1)))) / (scene.rtol * st.radius))
+    return worst
+
+
+def try_step(
+    method: implicit.Integrator, steps: list[implicit.ShellStep], state: tuple[F64, F64, F64], h: float
+) -> list[implicit.StepResult]:
+    """Every shell's step of ``h`` (s), or :class:`implicit.StepFailure`."""
+    x, v, a = state
+    return [implicit.step(method, st, x[k], v[k], a[k], h) for k, st in enumerate(steps)]
+
+
+def next_step(scene: Scene, method: implicit.Integrator, h: float, ratio: float) -> float:
+    """The step after an accepted one of ``h`` whose error ratio was ``ratio``."""
+    if not scene.adaptive:
+        return min(scene.dt, 2.0 * h)
+    q = integrator.error_exponent(method.solver)
+    grow = (
+        integrator.STEP_GROWTH if ratio <= 0.0 else min(integrator.STEP_GROWTH, max(SHRINK, 0.9 * ratio**-q))
+    )
+    return min(scene.dt, h * grow)
+
+
+class Run:
+    """A run's state between steps: positions, velocities, accelerations and contact forces
+    (shells, V, 3), and what it has recorded."""
+
+    def __init__(self, scene: Scene, x0: ArrayLike | None, v0: ArrayLike | None, output_dt: float | None):
+        self.scene = scene
+        self.method, self.steps = build(scene)
+        self.x, self.v = initial_states(scene, x0, v0)
+        self.a = np.array(
+            [implicit.initial_acceleration(st, self.x[k], self.v[k]) for k, st in enumerate(self.steps)]
+        )
+        self.force = np.zeros_like(self.x)
+        g = np.array(scene.gravity_vector)
+        self.up = -g / np.linalg.norm(g) if np.linalg.norm(g) > 0.0 else np.array([0.0, 0.0, 1.0])
+        self.recorder, self.stats = Recorder(output_dt, self.steps), SimulationStats()
+        self.events: list[tuple[float, int, str, float]] = []
+        self.recorder.add(0.0, self.x, self.v, self.force)
+
+    def accept(self, t: float, h: float, results: list[implicit.StepResult]) -> None:
+        """Takes the step ``[t, t + h]``: its events, records and work."""
+        x1, v1 = np.array([r.x for r in results]), np.array([r.v for r in results])
+        f1 = np.array([r.contact_force for r in results])
+        for k, st in enumerate(self.steps):
+            d0 = ground.min_distance(self.x[k], st.normals, st.heights)
+            d1 = ground.min_distance(x1[k], st.normals, st.heights)
+            ends = (self.x[k], self.v[k], d0), (x1[k], v1[k], d1)
+            self.events += events.detect(t, h, k, self.up, st.problem.model.mass, *ends, st.dhat)
+        self.recorder.step(t, h, (self.x, self.v, self.force), (x1, v1, f1))
+        self.stats.steps += 1
+        self.stats.newton_iterations += sum(r.iterations for r in results)
+        self.stats.cg_iterations += sum(r.cg_iterations for r in results)
+        self.stats.envelope_solves += sum(r.envelope_solves for r in results)
+        self.x, self.v, self.a, self.force = x1, v1, np.array([r.a for r in results]), f1
+
+    def reject(self, t: float, h: float, why: str) -> float:
+        """Counts a rejected step; returns ``h`` (s), the next try, unless below ``dt_min``."""
+        self.stats.rejections += 1
+        if h < self.scene.dt_min:
+            raise SimulationError(f"{why} below dt_min = {self.scene.dt_min:g} s at t = {t:.6g} s")
+        return h
+
+
+def simulate(
+    scene: Scene,
+    t_end: float,
+    x0: ArrayLike | None = None,
+    v0: ArrayLike | None = None,
+    output_dt: float | None = None,
+) -> Trajectory:
+    """Simulate ``scene`` from t = 0 to ``t_end`` (s) (module doc)."""
+    if not (isinstance(t_end, (int, float)) and np.isfinite(t_end) and 0.0 < t_end <= 1e6):
+        raise ValueError(f"t_end = {t_end!r} is out of range: must be a finite number in (0, 1e6] s")
+    if output_dt is not None and not (isinstance(output_dt, (int, float)) and 0.0 < output_dt <= t_end):
+        raise ValueError(
+            f"output_dt = {output_dt!r} is out of range: must be None or a number in (0, t_end] s"
+        )
+    run = Run(scene, x0, v0, output_dt)
+    method, q = run.method, integrator.error_exponent(run.method.solver)
+    t, h, clock = 0.0, scene.dt, time.perf_counter()
+    while t < t_end * (1.0 - 1e-12):
+        trial = min(h, t_end - t)
+        try:
+            results = try_step(method, run.steps, (run.x, run.v, run.a), trial)
+        except implicit.StepFailure:
+            h = run.reject(t, 0.5 * trial, "the step was halved")
+            continue
+        a1 = np.array([r.a for r in results])
+        ratio = error_ratio(scene, method, run.steps, run.a, a1, trial) if scene.adaptive else 0.0
+        if ratio > 1.0:
+            h = run.reject(t, trial * max(SHRINK, 0.9 * ratio**-q), "the error control shrank the step")
+            continue
+        run.accept(t, trial, results)
+        t += trial
+        h = next_step(scene, method, trial, ratio)
+    run.stats.wall_time = time.perf_counter() - clock
+    tt, xx, vv, ff, pp = run.recorder.arrays()
+    return Trajectory(tt, xx, vv, ff, pp, sorted(run.events), run.stats, scene)
