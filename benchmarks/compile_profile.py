@@ -1,0 +1,134 @@
+"""Where the first run's compile time goes, kernel by kernel: numba's compiler passes timed through
+its event API (``numba:run_pass``) in a process on an empty cache (``NUMBA_CACHE_DIR``), for the
+env's first steps (make, reset and three steps of ``InflatedBall-v3``) and for the first
+``simulate()`` of one ring on a floor (``Scene``'s defaults, 20 ms).
+
+A pass's time is its own (s): a callee compiled while its caller is typed is counted to the
+callee. Per function: typing (numba's type inference passes), lowering (``native_lowering``: the
+LLVM IR and its optimisation, which includes every callee inlined into it) and the rest of numba's
+passes. The table lists the functions that take the most, and the sums over all of them.
+
+    python benchmarks/compile_profile.py   # writes benchmarks/results/compile_profile.md
+"""
+
+import argparse
+import json
+import os
+import pathlib
+import subprocess
+import sys
+import tempfile
+import time
+
+from ballenv.files import write_text
+
+RESULTS = pathlib.Path(__file__).parent / "results"
+TOP = 15  # functions listed per scenario
+
+LISTENER = """
+import json, sys, time
+from numba.core import event
+
+stack, rows = [], {}
+
+
+class Passes(event.Listener):
+    def on_start(self, ev):
+        stack.append([ev.data["qualname"], ev.data["name"].split(" [")[0], time.perf_counter(), 0.0])
+
+    def on_end(self, ev):
+        name, step, start, nested = stack.pop()
+        spent = time.perf_counter() - start
+        row = rows.setdefault(name, {})
+        row[step] = row.get(step, 0.0) + spent - nested
+        if stack:
+            stack[-1][3] += spent
+
+
+event.register("numba:run_pass", Passes())
+"""
+
+SCENARIOS = {
+    "env": """
+import gymnasium as gym
+import ballenv  # noqa: F401
+env = gym.make("InflatedBall-v3")
+env.reset(seed=0)
+for _ in range(3):
+    env.step(env.action_space.sample())
+""",
+    "simulate": """
+from ballenv.physics import Ground, Ring, Scene, simulate
+simulate(Scene(rings=[Ring(radius=0.1, n_nodes=32, pressure=30e3, position=(0.0, 0.3))],
+               grounds=[Ground()]), t_end=0.02)
+""",
+}
+TYPING = ("nopython_type_inference", "partial_type_inference", "nopython_rewrites")
+LOWERING = ("native_lowering",)
+
+
+def profile(scenario):
+    """(wall s, {function: {pass: own s}}) of ``scenario`` on an empty cache."""
+    with tempfile.TemporaryDirectory() as cache:
+        out = pathlib.Path(cache) / "passes.json"
+        dump = f"\njson.dump(rows, open({str(out)!r}, 'w'))\n"
+        env = dict(os.environ, NUMBA_CACHE_DIR=str(pathlib.Path(cache) / "numba"))
+        start = time.perf_counter()
+        code = LISTENER + SCENARIOS[scenario] + dump
+        subprocess.run([sys.executable, "-c", code], env=env, check=True, capture_output=True)
+        return time.perf_counter() - start, json.loads(out.read_text())
+
+
+def split(passes):
+    """(typing, lowering, rest) s of one function's passes."""
+    typing = sum(t for p, t in passes.items() if p in TYPING)
+    lowering = sum(t for p, t in passes.items() if p in LOWERING)
+    return typing, lowering, sum(passes.values()) - typing - lowering
+
+
+def table(scenario, wall, rows):
+    """A results section for one scenario."""
+    parts = {name: split(passes) for name, passes in rows.items()}
+    total = [sum(p[k] for p in parts.values()) for k in range(3)]
+    lines = [
+        f"## {scenario}: {wall:.1f} s wall, {sum(total):.1f} s in numba's passes "
+        f"({len(rows)} functions; typing {total[0]:.1f} s, lowering {total[1]:.1f} s, "
+        f"other {total[2]:.1f} s)",
+        "",
+        "| function | typing (s) | lowering (s) | other (s) | total (s) |",
+        "|---|---:|---:|---:|---:|",
+    ]
+    ranked = sorted(parts.items(), key=lambda item: -sum(item[1]))
+    for name, (typing, lowering, rest) in ranked[:TOP]:
+        total = typing + lowering + rest
+        lines.append(f"| `{name}` | {typing:.2f} | {lowering:.2f} | {rest:.2f} | {total:.2f} |")
+    return "\n".join(lines)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", type=pathlib.Path, default=RESULTS / "compile_profile.md")
+    parser.add_argument("--scenario", choices=sorted(SCENARIOS), nargs="*", default=sorted(SCENARIOS))
+    args = parser.parse_args()
+    sections = []
+    loads = [os.getloadavg()[0]]
+    for scenario in args.scenario:
+        wall, rows = profile(scenario)
+        loads.append(os.getloadavg()[0])
+        sections.append(table(scenario, wall, rows))
+        print(sections[-1], flush=True)
+    page = (
+        "# Compile profile: where the first run's compile time goes\n\n"
+        f"`python benchmarks/compile_profile.py` on {os.cpu_count()} cores (1-minute load average "
+        f"{min(loads):.1f}-{max(loads):.1f}: above {os.cpu_count()}, other processes shared the cores), "
+        "an empty `NUMBA_CACHE_DIR` per scenario. Own time of numba's passes per function "
+        "(a callee compiled while its caller is typed counts to the callee); lowering includes LLVM's "
+        "optimisation of everything linked into the function. The machine's speed varies from day to "
+        "day: compare the shares, not the seconds of different days.\n\n" + "\n\n".join(sections) + "\n"
+    )
+    write_text(args.out, page)
+    print(f"wrote {args.out}")
+
+
+if __name__ == "__main__":
+    main()
