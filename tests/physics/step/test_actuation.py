@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from ballenv.physics import Ground, Ring, Scene
+from ballenv.physics.base.layout import ENERGY, ENERGY_BUDGET, ENERGY_FREE, ENERGY_MOTION, ENERGY_TOTAL
 from ballenv.physics.base.ring import inflated_radius, total_mass
 from ballenv.physics.build import build_model, build_workspace, empty_state, initial_state
 from ballenv.physics.effects.assembly import ring_force
@@ -37,9 +38,10 @@ def test_new_gas_amount_makes_its_inflated_circle_the_rest_state(n_nodes, pressu
     hoop = pressure * scene.rings[0].width * 2 * np.pi * radius / n_nodes  # p b l per node
     assert np.abs(force).max() < 1e-9 * hoop  # wall tension balances the gas on the circle
     assert ring_pressure(model, 0, circle) == pytest.approx(pressure, rel=1e-12)
-    out = np.zeros(2)
+    out = np.zeros(ENERGY.size)
     free_energy(model, 0, circle, np.zeros_like(circle), ws, out)
-    assert abs(out[1]) < 1e-12 * abs(out[0])  # the circle at rest has no free energy
+    assert abs(out[ENERGY_FREE]) < 1e-12 * abs(out[ENERGY_TOTAL])  # the circle at rest has no free energy
+    assert out[ENERGY_MOTION] == 0.0
 
 
 def test_gas_change_updates_the_carried_energy_and_keeps_the_acceleration():
@@ -48,13 +50,15 @@ def test_gas_change_updates_the_carried_energy_and_keeps_the_acceleration():
     initial_state_values(model, build_solver(scene), state, ws)
     before = state.energy[0].copy()
     acceleration = state.a[0].copy()
-    assert before[2] == before[0] != 0.0  # the budget starts at the ring's energy
+    assert before[ENERGY_BUDGET] == before[ENERGY_TOTAL] != 0.0  # the budget starts at the ring's energy
     set_rest_pressure(model, 0, 50e3, state.x[0], state.v[0], state.energy[0], ws)
-    expected = np.zeros(2)
+    expected = np.zeros(ENERGY.size)
     free_energy(model, 0, state.x[0], state.v[0], ws, expected)
-    np.testing.assert_allclose(state.energy[0, :2], expected, rtol=1e-14)
+    for column in (ENERGY_TOTAL, ENERGY_FREE, ENERGY_MOTION):
+        assert state.energy[0, column] == pytest.approx(expected[column], rel=1e-14, abs=1e-300)
     # the budget moves with the work of the actuation
-    assert state.energy[0, 2] - before[2] == pytest.approx(expected[0] - before[0], rel=1e-12)
+    gained = expected[ENERGY_TOTAL] - before[ENERGY_TOTAL]
+    assert state.energy[0, ENERGY_BUDGET] - before[ENERGY_BUDGET] == pytest.approx(gained, rel=1e-12)
     # the integrator's carried acceleration is not restarted (it is F / m of the old gas amount)
     np.testing.assert_array_equal(state.a[0], acceleration)
     force = np.zeros((32, 2))

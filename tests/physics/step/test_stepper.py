@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from ballenv.physics import Ground, Ring, Scene, simulate
+from ballenv.physics.base.layout import ENERGY, ENERGY_FREE, ENERGY_MOTION, ENERGY_TOTAL
 from ballenv.physics.build import build_model, build_workspace, initial_state
 from ballenv.physics.step.energy_budget import energy_grew, free_energy
 
@@ -50,15 +51,21 @@ def test_energy_guard_flags_a_step_that_adds_energy():
     x, v = initial_state(scene)
     ws = build_workspace(x.shape[1])
     moving = v[0] + np.array([0.0, 0.05])  # kinetic energy from nowhere
-    at_rest, kicked, broken = np.zeros(2), np.zeros(2), np.zeros(2)
+    at_rest, kicked, broken = np.zeros(ENERGY.size), np.zeros(ENERGY.size), np.zeros(ENERGY.size)
     free_energy(model, 0, x[0], v[0], ws, at_rest)
     free_energy(model, 0, x[0], moving, ws, kicked)
     free_energy(model, 0, x[0], np.full_like(moving, np.nan), ws, broken)
-    assert at_rest[1] == pytest.approx(0.0, abs=1e-12 * at_rest[0])  # the inflated circle is the rest state
-    assert not energy_grew(*at_rest, *at_rest)
-    assert energy_grew(*at_rest, *kicked)
-    assert not energy_grew(*kicked, *at_rest)
-    assert energy_grew(*at_rest, *broken)
+    # the inflated circle is the rest state
+    assert at_rest[ENERGY_FREE] == pytest.approx(0.0, abs=1e-12 * at_rest[ENERGY_TOTAL])
+
+    def grew(before, after):  # as within_energy_budget asks (energy_budget.exchanged_energy)
+        exchanged = [max(row[ENERGY_FREE], row[ENERGY_MOTION]) for row in (before, after)]
+        return energy_grew(before[ENERGY_TOTAL], exchanged[0], after[ENERGY_TOTAL], exchanged[1])
+
+    assert not grew(at_rest, at_rest)
+    assert grew(at_rest, kicked)
+    assert not grew(kicked, at_rest)
+    assert grew(at_rest, broken)
 
 
 def test_friction_on_arriving_nodes_does_not_stall_newton():
