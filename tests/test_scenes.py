@@ -112,13 +112,14 @@ def test_a_ball_on_a_vibrating_plate_bounces_regularly_then_doubles_its_period()
 
 
 def test_a_ribbon_loop_in_a_rotating_drum_rolls_and_elongates_with_speed():
-    """Fast preset, the drum at rest and at Fr = Omega^2 R_d / g = 3.9: the loop rolls (its spin
-    within 30 % of ``Omega R_d / r``, an oval's tank-treading is not a rigid spin), is longer than at
-    rest (aspect ratio up by more than 0.1; measured 1.99 -> 2.26) and climbs the drum's wall in its
-    sense of turning (centre angle 0.2 ... 1.2 rad; measured 0.84)."""
+    """Balanced preset (the fast one's spin is 20 % below the accurate preset's here: 66 against 85
+    rad/s), the drum at rest and at Fr = Omega^2 R_d / g = 3.9: the loop rolls (its spin within 30 %
+    of ``Omega R_d / r``, an oval's tank-treading is not a rigid spin), is longer than at rest
+    (aspect ratio up by more than 0.1) and climbs the drum's wall in its sense of turning (centre
+    angle 0.2 ... 1.2 rad)."""
     from ballenv.scenes.library import DRUM_RADIUS, RIBBON
 
-    rest, fast = scenes.run("rotating-drum", **FAST).metrics["rows"]
+    rest, fast = scenes.run("rotating-drum", fidelity="balanced", reduced=True).metrics["rows"]
     assert rest["froude"] == 0.0 and fast["froude"] > 3.5
     rolling = fast["drum_spin_rad_per_s"] * DRUM_RADIUS / RIBBON["radius"]
     assert fast["ribbon_spin_rad_per_s"] == pytest.approx(rolling, rel=0.3)

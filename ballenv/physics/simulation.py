@@ -202,7 +202,14 @@ class Simulation:
             )  # fmt: skip
             if status != STATUS_BUFFER_FULL:
                 return status
-            self.rec = _grown(self.rec, self.counters)
+            self.rec = _grown(self.rec, self.counters, self._records_per_step())
+
+    def _records_per_step(self) -> int:
+        """The most records one step may write: its end and the output times inside it (a step is
+        at most ``Scene.dt`` long; ``step.stepper.records_needed``)."""
+        if self.output_dt is None:
+            return 1
+        return 2 + int(np.ceil(self.scene.dt / self.output_dt))
 
     def _rescued(self, status: int, t_end: float) -> bool:
         """Newton's rescue of a run that stopped because rejections for Newton failures halved the
@@ -442,12 +449,18 @@ def _check_ring_shapes(caller: str, scene: Scene, x: NDArray[np.float64]) -> Non
             )
 
 
-def _grown(rec: Recording, counters: NDArray[np.int64]) -> Recording:
-    """A recording with room for more records and events, holding what ``rec`` has."""
+def _grown(rec: Recording, counters: NDArray[np.int64], per_step: int) -> Recording:
+    """A recording holding what ``rec`` has, with twice the room for records if fewer than
+    ``per_step`` (the most one step may write) are left, and for events if fewer than a step's
+    (three per ring) are left."""
     n_out = int(counters[COUNT_RECORDS])
     n_ev = int(counters[COUNT_EVENTS])
-    out_cap = rec.t.shape[0] * (2 if n_out >= rec.t.shape[0] else 1)
-    ev_cap = rec.events.shape[0] * 2
+    out_cap = rec.t.shape[0]
+    while n_out + per_step > out_cap:
+        out_cap *= 2
+    ev_cap = rec.events.shape[0]
+    if n_ev + 3 * rec.x.shape[1] > ev_cap:
+        ev_cap *= 2
     grown = empty_recording(out_cap, rec.x.shape[1], rec.x.shape[2], ev_cap)
     for old, new in zip(rec[:-1], grown[:-1], strict=True):
         new[:n_out] = old[:n_out]
