@@ -10,7 +10,7 @@ STAMP := $(VENV)/.installed
 TRAIN_STAMP := $(VENV)/.installed-train
 export OPENBLAS_NUM_THREADS := 1
 
-.PHONY: venv train demo scenes test test-slow docs bench soak lint format clean clean-cache
+.PHONY: venv compile train demo scenes test test-slow docs bench soak lint format clean clean-cache
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -25,6 +25,11 @@ $(TRAIN_STAMP): pyproject.toml constraints.txt | $(PY)
 	touch $(TRAIN_STAMP)
 
 venv: $(STAMP)
+
+# numba's cache filled for the env and the common scenes ahead of a first run, a process per core
+# (ballenv/compile.py)
+compile: $(STAMP)
+	$(PY) -m ballenv.compile
 
 # PPO started from a clone of the privileged lookahead's demonstrations (60 episodes on training
 # seeds), 2,048 bounces of PPO, then the scoreboard on 30 held-out episodes (seeds 10,000 on), the

@@ -3,6 +3,12 @@ its event API (``numba:run_pass``) in a process on an empty cache (``NUMBA_CACHE
 env's first steps (make, reset and three steps of ``InflatedBall-v3``) and for the first
 ``simulate()`` of one ring on a floor (``Scene``'s defaults, 20 ms).
 
+Each scenario runs twice in the same minute: as the package compiles (machine code only for the
+entry points Python calls, ``ballenv/physics/base/machine_code.py``) and with numba's own code
+library put back (every compiled function optimised and emitted on its own, as numba does by
+default), so the page shows what the lazy machine code saves as a ratio on the same machine. The
+libraries whose module LLVM optimised and turned into machine code are counted, with that time.
+
 A pass's time is its own (s): a callee compiled while its caller is typed is counted to the
 callee. Per function: typing (numba's type inference passes), lowering (``native_lowering``: the
 LLVM IR and its optimisation, which includes every callee inlined into it) and the rest of numba's
@@ -46,6 +52,29 @@ class Passes(event.Listener):
 
 
 event.register("numba:run_pass", Passes())
+
+import ballenv.physics.base.jit  # noqa: E402,F401  (installs the lazy code library)
+from numba.core import codegen  # noqa: E402
+
+backend = {"libraries": 0, "seconds": 0.0}
+
+
+def timed(method):
+    def run(self, *args):
+        start = time.perf_counter()
+        try:
+            return method(self, *args)
+        finally:
+            backend["seconds"] += time.perf_counter() - start
+            backend["libraries"] += method.__name__ == "_finalize_specific"
+    return run
+
+
+if EAGER:  # numba's own library: every function's module optimised and emitted at once
+    codegen.JITCPUCodegen._library_class = codegen.JITCodeLibrary
+    codegen.JITCPUCodegen.set_env = ballenv.physics.base.machine_code._numba_set_env
+codegen.CPUCodeLibrary._optimize_final_module = timed(codegen.CPUCodeLibrary._optimize_final_module)
+codegen.JITCodeLibrary._finalize_specific = timed(codegen.JITCodeLibrary._finalize_specific)
 """
 
 SCENARIOS = {
@@ -63,20 +92,24 @@ simulate(Scene(rings=[Ring(radius=0.1, n_nodes=32, pressure=30e3, position=(0.0,
                grounds=[Ground()]), t_end=0.02)
 """,
 }
+LIBRARIES = {"lazy (the package)": False, "eager (numba's own)": True}
 TYPING = ("nopython_type_inference", "partial_type_inference", "nopython_rewrites")
 LOWERING = ("native_lowering",)
 
 
-def profile(scenario):
-    """(wall s, {function: {pass: own s}}) of ``scenario`` on an empty cache."""
+def profile(scenario, eager):
+    """(wall s, {function: {pass: own s}}, {"libraries": emitted, "seconds": LLVM module
+    optimisation and machine code}) of ``scenario`` on an empty cache; with ``eager``, numba's own
+    code library."""
     with tempfile.TemporaryDirectory() as cache:
         out = pathlib.Path(cache) / "passes.json"
-        dump = f"\njson.dump(rows, open({str(out)!r}, 'w'))\n"
+        dump = f"\njson.dump([rows, backend], open({str(out)!r}, 'w'))\n"
         env = dict(os.environ, NUMBA_CACHE_DIR=str(pathlib.Path(cache) / "numba"))
         start = time.perf_counter()
-        code = LISTENER + SCENARIOS[scenario] + dump
+        code = f"EAGER = {eager}\n" + LISTENER + SCENARIOS[scenario] + dump
         subprocess.run([sys.executable, "-c", code], env=env, check=True, capture_output=True)
-        return time.perf_counter() - start, json.loads(out.read_text())
+        rows, backend = json.loads(out.read_text())
+        return time.perf_counter() - start, rows, backend
 
 
 def split(passes):
@@ -86,14 +119,31 @@ def split(passes):
     return typing, lowering, sum(passes.values()) - typing - lowering
 
 
-def table(scenario, wall, rows):
-    """A results section for one scenario."""
-    parts = {name: split(passes) for name, passes in rows.items()}
-    total = [sum(p[k] for p in parts.values()) for k in range(3)]
+def summary(scenario, runs):
+    """A results table of ``scenario``: lazy and eager machine code side by side."""
     lines = [
-        f"## {scenario}: {wall:.1f} s wall, {sum(total):.1f} s in numba's passes "
-        f"({len(rows)} functions; typing {total[0]:.1f} s, lowering {total[1]:.1f} s, "
-        f"other {total[2]:.1f} s)",
+        f"## {scenario}",
+        "",
+        "| code library | wall (s) | numba's passes (s) | typing (s) | lowering (s) | libraries emitted "
+        "| their optimisation and machine code (s) |",
+        "|---|---:|---:|---:|---:|---:|---:|",
+    ]
+    for label, (wall, rows, backend) in runs.items():
+        total = [sum(split(p)[k] for p in rows.values()) for k in range(3)]
+        lines.append(
+            f"| {label} | {wall:.1f} | {sum(total):.1f} | {total[0]:.1f} | {total[1]:.1f} "
+            f"| {backend['libraries']} | {backend['seconds']:.1f} |"
+        )
+    walls = [run[0] for run in runs.values()]
+    lines += ["", f"Wall time, lazy over eager: {walls[0] / walls[1]:.2f}.", ""]
+    return "\n".join(lines)
+
+
+def table(scenario, wall, rows):
+    """The functions of one scenario's run that take the most."""
+    parts = {name: split(passes) for name, passes in rows.items()}
+    lines = [
+        f"Functions of the lazy run that take the most ({len(rows)} compiled):",
         "",
         "| function | typing (s) | lowering (s) | other (s) | total (s) |",
         "|---|---:|---:|---:|---:|",
@@ -113,9 +163,10 @@ def main():
     sections = []
     loads = [os.getloadavg()[0]]
     for scenario in args.scenario:
-        wall, rows = profile(scenario)
+        runs = {label: profile(scenario, eager) for label, eager in LIBRARIES.items()}
         loads.append(os.getloadavg()[0])
-        sections.append(table(scenario, wall, rows))
+        lazy = runs[next(iter(LIBRARIES))]
+        sections.append(summary(scenario, runs) + "\n" + table(scenario, lazy[0], lazy[1]))
         print(sections[-1], flush=True)
     page = (
         "# Compile profile: where the first run's compile time goes\n\n"
@@ -123,7 +174,8 @@ def main():
         f"{min(loads):.1f}-{max(loads):.1f}: above {os.cpu_count()}, other processes shared the cores), "
         "an empty `NUMBA_CACHE_DIR` per scenario. Own time of numba's passes per function "
         "(a callee compiled while its caller is typed counts to the callee); lowering includes LLVM's "
-        "optimisation of everything linked into the function. The machine's speed varies from day to "
+        "optimisation and machine code of the function's library, with everything linked into it. "
+        "The machine's speed varies from day to "
         "day: compare the shares, not the seconds of different days.\n\n" + "\n\n".join(sections) + "\n"
     )
     write_text(args.out, page)

@@ -19,6 +19,8 @@ by other kernels. So a kernel is compiled without them (numba's ``no_cpython_wra
 function compiled with the wrappers, cached under its own name (``<name>.python``), compiled only
 for kernels Python calls (``simulate``'s driver, the env's step and reset, a test). Processes that
 compile the same twin for the same argument types at once compile it once (:mod:`.compile_lock`).
+Only the twins are turned into machine code; the kernels they call stay LLVM IR, linked into each
+twin (:mod:`.machine_code`).
 """
 
 import types
@@ -26,11 +28,12 @@ import types
 from numba import njit
 from numba.core.registry import CPUDispatcher
 
-from . import cache_location
+from . import cache_location, machine_code
 from .compile_lock import SharedCompile
 
 OPTIONS = {"cache": cache_location.apply(), "_nrt": False}  # no cache only where nothing is writable
 WRAPPERS = ("no_cpython_wrapper", "no_cfunc_wrapper")
+machine_code.install()
 
 
 class InnerKernel(CPUDispatcher):
