@@ -91,7 +91,13 @@ def console_scripts(wheel):
 
 def test_the_console_scripts_resolve_and_answer_help(wheel, capsys):
     scripts = console_scripts(wheel)
-    assert set(scripts) == {"ballenv-train", "ballenv-evaluate", "ballenv-scenes", "ballenv-viewer"}
+    assert set(scripts) == {
+        "ballenv-train",
+        "ballenv-evaluate",
+        "ballenv-scenes",
+        "ballenv-viewer",
+        "ballenv-compile",
+    }
     for name, target in scripts.items():
         module, function = target.split(":")
         main = getattr(importlib.import_module(module), function)

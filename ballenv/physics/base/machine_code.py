@@ -32,10 +32,11 @@ class LazyLibrary(codegen.JITCodeLibrary):
     _deferred = False
 
     def _optimize_final_module(self):
-        self._deferred = True
+        super()._optimize_final_module()
+        self._deferred = True  # a library being finalised: its machine code waits
 
     def _finalize_final_module(self):
-        if not self._deferred:
+        if not self._deferred:  # one loaded with its machine code from the cache
             self._emit()
             return
         self._verify_declare_only_symbols()
@@ -49,10 +50,9 @@ class LazyLibrary(codegen.JITCodeLibrary):
                 _numba_set_env(self._codegen, name, _waiting_envs.pop(name))
 
     def _undefer(self):
-        """Optimise the module and emit its machine code, as numba's ``finalize`` would have."""
+        """Emit the optimised module's machine code, as numba's ``finalize`` would have."""
         if self._deferred:
             self._deferred = False
-            super()._optimize_final_module()
             self._emit()
 
     def get_pointer_to_function(self, name):
