@@ -1,22 +1,22 @@
 """Machine code only where Python calls: a compiled function that only other compiled code calls
-keeps its LLVM IR and is never optimised on its own nor turned into machine code.
+keeps its optimised LLVM IR and is never turned into machine code on its own.
 
 numba compiles every function into a code library and, as soon as it is compiled, optimises the
 library's module (the function with every callee linked into it) and emits its machine code, so that
-a pointer to it exists. A caller then links the callee's IR into its own library and does the same
-again: a callee at depth d of the call tree is optimised and emitted d + 1 times. The simulator's
-kernels are a deep tree that only a few entry points (:func:`.jit.python_entry`) are called through,
-so most of that work is thrown away (measured on the env's first steps: 131 libraries finalised,
-about 17 s of a 70 s cold start in module optimisation and machine code of libraries nobody runs).
+a pointer to it exists. A caller then links the callee's optimised IR into its own library and does
+the same again: a callee at depth d of the call tree is emitted d + 1 times. The simulator's kernels
+are a deep tree that only a few entry points (:func:`.jit.python_entry`) are called through, so most
+of that machine code is thrown away (the env's first steps: 166 libraries, 5 of them entry points).
 
-:class:`LazyLibrary` (installed as the CPU codegen's library class by :func:`install`) postpones a
-library's module optimisation and machine code until a pointer to one of its functions is asked for.
-A kernel compiled without Python wrappers (:func:`.jit.kernel`) is asked only for the wrapper it
-does not have, so it stays IR; an entry point is asked for its wrapper, and its library, with every
-callee linked in, is optimised once and emitted once, exactly as numba would have done. Its cache
-entry holds its IR (numba's "bitcode" kind) instead of machine code; a caller compiled in a later
-process links that IR. The environment pointer numba stores in a library's module (exceptions,
-boxing) is stored when that module reaches the engine (:func:`_set_env`).
+:class:`LazyLibrary` (installed as the CPU codegen's library class by :func:`install`) optimises a
+library's module as numba does (callees reach their callers optimised, so the entry points inline
+as before and their code is numba's own) but postpones its machine code until a pointer to one of
+its functions is asked for. A kernel compiled without Python wrappers (:func:`.jit.kernel`) is asked
+only for the wrapper it does not have, so it stays IR; an entry point is asked for its wrapper, and
+its library, with every callee linked in, is emitted once. An inner kernel's cache entry holds its
+optimised IR (numba's "bitcode" kind) instead of machine code; a caller compiled in a later process
+links that IR. The environment pointer numba stores in a library's module (exceptions, boxing) is
+stored when that module reaches the engine (:func:`_set_env`).
 """
 
 import llvmlite.binding as ll
@@ -26,7 +26,7 @@ _waiting_envs = {}  # environment global name -> numba Environment, set once a m
 
 
 class LazyLibrary(codegen.JITCodeLibrary):
-    """numba's JIT code library whose module optimisation and machine code wait for the first
+    """numba's JIT code library whose machine code waits for the first
     :meth:`get_pointer_to_function` of a function it defines (see the module doc)."""
 
     _deferred = False
