@@ -1,62 +1,73 @@
-"""Conjugate gradients with a Jacobi (diagonal) preconditioner on a shell's Newton system, the
-matrix applied element by element (its triangles' and hinges' matrices, the rank-one gas term and a
-diagonal), never assembled: the iterative alternative to the envelope Cholesky (envelope.py).
+"""Conjugate gradients with a Jacobi (diagonal) preconditioner on a shell's linear systems: the
+one CG of the package (the static systems of the benchmarks and tests, and each time step's Newton
+system, stepsolve.py), on the operator it is handed.
 
-Solves ``(K + diag(D) + s u u^T) x = r`` over the free degrees of freedom until
-``|residual| <= rtol |r|`` (2-norms) or ``max_iter`` iterations; fixed entries of ``x`` are zero.
+The operator (N/m) is a block-sparse matrix (blocks.py) plus a diagonal plus low-rank terms::
+
+    A = B + diag(D) + sum_k w_k u_k u_k^T
+
+(``D`` (V, 3); ``u_k`` (K, V, 3) with weights ``w_k``: the gas's rank-one term ``s dV dV^T``, the
+damping's rank-6 term ``-d W W^T``; a zero weight is skipped). :func:`pcg` solves ``A x = r`` over
+the free degrees of freedom until ``|residual| <= rtol |r|`` (2-norms) or ``max_iter`` iterations;
+fixed entries of ``x`` are zero.
 """
 
+from typing import NamedTuple
+
 import numpy as np
+from numpy.typing import NDArray
 
 from ..physics.base.jit import kernel
+from . import blocks
+
+
+class Operator(NamedTuple):
+    """``A`` of the module doc: its block matrix and the terms added to it."""
+
+    pattern: blocks.BlockPattern
+    values: NDArray[np.float64]  # (B, 3, 3) N/m
+    diagonal: NDArray[np.float64]  # (V, 3) N/m
+    vectors: NDArray[np.float64]  # (K, V, 3)
+    weights: NDArray[np.float64]  # (K,)
+
+
+def make_operator(pattern: blocks.BlockPattern, rank: int) -> Operator:
+    """An operator of ``pattern`` with room for ``rank`` low-rank terms, all zero."""
+    n_vertices = len(pattern.row_start) - 1
+    z = np.zeros
+    values = z((len(pattern.cols), 3, 3))
+    return Operator(pattern, values, z((n_vertices, 3)), z((rank, n_vertices, 3)), z(rank))
 
 
 @kernel
-def _apply_elements(elements, mats, x, free, y):
-    n_v = elements.shape[1]
-    for e in range(elements.shape[0]):
-        for a in range(n_v):
+def apply(op, x, y):
+    """``y = A x`` (V, 3)."""
+    blocks.multiply(op.pattern, op.values, x, y)
+    for v in range(x.shape[0]):
+        for c in range(3):
+            y[v, c] += op.diagonal[v, c] * x[v, c]
+    for k in range(op.weights.shape[0]):
+        if op.weights[k] == 0.0:
+            continue
+        ux = 0.0
+        for v in range(x.shape[0]):
             for c in range(3):
-                va = elements[e, a]
-                if not free[va, c]:
-                    continue
-                s = 0.0
-                for b in range(n_v):
-                    vb = elements[e, b]
-                    for d in range(3):
-                        s += mats[e, 3 * a + c, 3 * b + d] * x[vb, d]
-                y[va, c] += s
+                ux += op.vectors[k, v, c] * x[v, c]
+        f = op.weights[k] * ux
+        for v in range(x.shape[0]):
+            for c in range(3):
+                y[v, c] += f * op.vectors[k, v, c]
 
 
 @kernel
-def apply(triangles, tri_mats, hinges, hinge_mats, diagonal, s, u, free, x, y):
-    """``y`` = (K + diag + s u u^T) ``x`` on the free entries (``x`` zero on the fixed ones)."""
-    ux = 0.0
-    for v in range(x.shape[0]):
-        for c in range(3):
-            y[v, c] = diagonal[v, c] * x[v, c]
-            ux += u[v, c] * x[v, c]
-    _apply_elements(triangles, tri_mats, x, free, y)
-    _apply_elements(hinges, hinge_mats, x, free, y)
-    for v in range(x.shape[0]):
-        for c in range(3):
-            y[v, c] = y[v, c] + s * ux * u[v, c] if free[v, c] else 0.0
-
-
-@kernel
-def matrix_diagonal(triangles, tri_mats, hinges, hinge_mats, diagonal, s, u, out):
-    """The diagonal of (K + diag + s u u^T) into ``out`` (V, 3)."""
+def matrix_diagonal(op, out):
+    """The diagonal of ``A`` into ``out`` (V, 3)."""
     for v in range(out.shape[0]):
+        k = op.pattern.diagonal_slot[v]
         for c in range(3):
-            out[v, c] = diagonal[v, c] + s * u[v, c] * u[v, c]
-    for e in range(triangles.shape[0]):
-        for a in range(3):
-            for c in range(3):
-                out[triangles[e, a], c] += tri_mats[e, 3 * a + c, 3 * a + c]
-    for e in range(hinges.shape[0]):
-        for a in range(4):
-            for c in range(3):
-                out[hinges[e, a], c] += hinge_mats[e, 3 * a + c, 3 * a + c]
+            out[v, c] = op.values[k, c, c] + op.diagonal[v, c]
+            for j in range(op.weights.shape[0]):
+                out[v, c] += op.weights[j] * op.vectors[j, v, c] * op.vectors[j, v, c]
 
 
 @kernel
@@ -70,11 +81,11 @@ def _dot(a, b, free):
 
 
 @kernel
-def pcg(triangles, tri_mats, hinges, hinge_mats, diagonal, s, u, free, rhs, x, work, rtol, max_iter):
-    """Jacobi-preconditioned CG from ``x = 0``; ``work`` (4, V, 3) scratch. Returns the iterations
-    taken, or -1 if ``max_iter`` was reached first."""
+def pcg(op, free, rhs, x, work, rtol, max_iter):
+    """Jacobi-preconditioned CG on ``A x = rhs`` from ``x = 0``; ``work`` (4, V, 3) scratch. Returns
+    the iterations taken, or -1 if ``max_iter`` was reached first."""
     r, p, q, dinv = work[0], work[1], work[2], work[3]
-    matrix_diagonal(triangles, tri_mats, hinges, hinge_mats, diagonal, s, u, dinv)
+    matrix_diagonal(op, dinv)
     for v in range(x.shape[0]):
         for c in range(3):
             dinv[v, c] = 1.0 / dinv[v, c] if free[v, c] else 0.0
@@ -86,15 +97,13 @@ def pcg(triangles, tri_mats, hinges, hinge_mats, diagonal, s, u, free, rhs, x, w
     for it in range(max_iter):
         if np.sqrt(_dot(r, r, free)) <= goal:
             return it
-        apply(triangles, tri_mats, hinges, hinge_mats, diagonal, s, u, free, p, q)
+        apply(op, p, q)
         alpha = rz / _dot(p, q, free)
+        rz_new = 0.0
         for v in range(x.shape[0]):
             for c in range(3):
                 x[v, c] += alpha * p[v, c]
                 r[v, c] -= alpha * q[v, c]
-        rz_new = 0.0
-        for v in range(x.shape[0]):
-            for c in range(3):
                 rz_new += r[v, c] * dinv[v, c] * r[v, c]
         beta = rz_new / rz
         rz = rz_new
