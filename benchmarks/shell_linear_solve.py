@@ -1,7 +1,8 @@
 """Options for the Newton linear solve of the 3-D shell, measured on the same systems: the envelope
 Cholesky after reverse Cuthill-McKee with the gas's rank-one term by Sherman-Morrison (kept,
 ballenv/shell/envelope.py), Jacobi-preconditioned CG on the element matrices assembled as a
-block-sparse matrix (ballenv/shell/cg.py, blocks.py; the assembly is in its time), and a dense LU (LAPACK through NumPy's np.linalg.solve) as the reference.
+block-sparse matrix (ballenv/shell/cg.py, blocks.py; the assembly is in its time), and a dense LU
+(LAPACK through NumPy's np.linalg.solve) as the reference.
 
     python benchmarks/shell_linear_solve.py     # writes benchmarks/results/shell_linear_solve.md
 
