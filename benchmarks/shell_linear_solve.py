@@ -104,13 +104,13 @@ def measure(subdivisions, dt):
     err_env = float(np.abs(out - exact).max() / np.abs(exact).max())
     x_cg, work = np.zeros_like(rhs), np.zeros((4,) + rhs.shape)
     op = cg.make_operator(blocks.block_pattern(len(model.rest), model.triangles, model.hinges), 1)
-    op.diagonal[:] = diagonal
+    for c in range(3):
+        op.vertex_blocks[:, c, c] = diagonal[:, c]
     op.vectors[0] = ws.dvol
     op.weights[0] = s
-    no_blocks = np.zeros((len(model.rest), 3, 3))
 
     def assemble_and_solve():
-        blocks.assemble(op.pattern, ws.tri_hess, ws.hinge_hess, 1.0, no_blocks, op.values)
+        blocks.assemble(op.pattern, ws.tri_hess, ws.hinge_hess, 1.0, op.values)
         return cg.pcg(op, free, rhs, x_cg, work, CG_RTOL, 100_000)
 
     iterations = assemble_and_solve()

@@ -60,17 +60,11 @@ def _scatter(slots, mats, scale, values):
 
 
 @kernel
-def assemble(pattern, tri_mats, hinge_mats, scale, vertex_blocks, values):
-    """``values`` (B, 3, 3) = ``scale`` (triangles' + hinges' matrices) + the vertex blocks (V, 3, 3)
-    on the diagonal."""
+def assemble(pattern, tri_mats, hinge_mats, scale, values):
+    """``values`` (B, 3, 3) = ``scale`` (triangles' + hinges' matrices)."""
     values[:] = 0.0
     _scatter(pattern.tri_slots, tri_mats, scale, values)
     _scatter(pattern.hinge_slots, hinge_mats, scale, values)
-    for v in range(vertex_blocks.shape[0]):
-        k = pattern.diagonal_slot[v]
-        for c in range(3):
-            for d in range(3):
-                values[k, c, d] += vertex_blocks[v, c, d]
 
 
 @kernel(fastmath=True)

@@ -2,12 +2,14 @@
 one CG of the package (the static systems of the benchmarks and tests, and each time step's Newton
 system, stepsolve.py), on the operator it is handed.
 
-The operator (N/m) is a block-sparse matrix (blocks.py) plus a diagonal plus low-rank terms::
+The operator (N/m) is a block-sparse matrix (blocks.py) plus 3 x 3 vertex blocks plus low-rank
+terms::
 
-    A = B + diag(D) + sum_k w_k u_k u_k^T
+    A = B + blockdiag(D_v) + sum_k w_k u_k u_k^T
 
-(``D`` (V, 3); ``u_k`` (K, V, 3) with weights ``w_k``: the gas's rank-one term ``s dV dV^T``, the
-damping's rank-6 term ``-d W W^T``; a zero weight is skipped). :func:`pcg` solves ``A x = r`` over
+(``D`` (V, 3, 3): a diagonal mass term, the grounds' barriers and friction; ``u_k`` (K, V, 3)
+with weights ``w_k``: the gas's rank-one term ``s dV dV^T``, the damping's rank-6 term
+``-d W W^T``; a zero weight is skipped). :func:`pcg` solves ``A x = r`` over
 the free degrees of freedom until ``|residual| <= rtol |r|`` (2-norms) or ``max_iter`` iterations;
 fixed entries of ``x`` are zero.
 """
@@ -26,7 +28,7 @@ class Operator(NamedTuple):
 
     pattern: blocks.BlockPattern
     values: NDArray[np.float64]  # (B, 3, 3) N/m
-    diagonal: NDArray[np.float64]  # (V, 3) N/m
+    vertex_blocks: NDArray[np.float64]  # (V, 3, 3) N/m
     vectors: NDArray[np.float64]  # (K, V, 3)
     weights: NDArray[np.float64]  # (K,)
 
@@ -36,16 +38,18 @@ def make_operator(pattern: blocks.BlockPattern, rank: int) -> Operator:
     n_vertices = len(pattern.row_start) - 1
     z = np.zeros
     values = z((len(pattern.cols), 3, 3))
-    return Operator(pattern, values, z((n_vertices, 3)), z((rank, n_vertices, 3)), z(rank))
+    return Operator(pattern, values, z((n_vertices, 3, 3)), z((rank, n_vertices, 3)), z(rank))
 
 
 @kernel
 def apply(op, x, y):
     """``y = A x`` (V, 3)."""
     blocks.multiply(op.pattern, op.values, x, y)
+    d = op.vertex_blocks
     for v in range(x.shape[0]):
+        x0, x1, x2 = x[v, 0], x[v, 1], x[v, 2]
         for c in range(3):
-            y[v, c] += op.diagonal[v, c] * x[v, c]
+            y[v, c] += d[v, c, 0] * x0 + d[v, c, 1] * x1 + d[v, c, 2] * x2
     for k in range(op.weights.shape[0]):
         if op.weights[k] == 0.0:
             continue
@@ -65,7 +69,7 @@ def matrix_diagonal(op, out):
     for v in range(out.shape[0]):
         k = op.pattern.diagonal_slot[v]
         for c in range(3):
-            out[v, c] = op.values[k, c, c] + op.diagonal[v, c]
+            out[v, c] = op.values[k, c, c] + op.vertex_blocks[v, c, c]
             for j in range(op.weights.shape[0]):
                 out[v, c] += op.weights[j] * op.vectors[j, v, c] * op.vectors[j, v, c]
 

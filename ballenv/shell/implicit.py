@@ -43,6 +43,10 @@ from .stepdata import ShellStep, Start, make_start
 F64 = NDArray[np.float64]
 FRICTION_LAGS = 3  # updates of the lagged normal forces within a step
 LAG_TOL = 1e-3  # their change (relative to the weight) that asks for another
+FORCING = 0.25  # a Newton direction's linear residual against the force Newton's test asks for
+CG_RTOL_MIN = 1e-8  # its bounds relative to the gradient
+CG_RTOL_MAX = 1e-2
+LAG_CONTRACTION = 0.1  # a Newton residual above this fraction of the last asks for new element matrices
 FAILURES = {
     1: "a non-finite gradient",
     2: "no convergence within newton_max_iter Newton iterations",
@@ -127,6 +131,19 @@ def _residual(grad, mass):
 
 
 @kernel
+def _forcing(grad, force_goal):
+    """CG's relative tolerance for a Newton direction from the gradient ``grad`` (N): a residual of
+    ``FORCING`` times the force ``force_goal`` (N) that Newton's test asks for, within
+    ``[CG_RTOL_MIN, CG_RTOL_MAX]`` (a linear residual below the test's needs no further iteration;
+    one far below the error of the linearisation is wasted)."""
+    norm = 0.0
+    for i in range(grad.shape[0]):
+        for c in range(3):
+            norm += grad[i, c] * grad[i, c]
+    return min(CG_RTOL_MAX, max(CG_RTOL_MIN, FORCING * force_goal / math.sqrt(norm)))
+
+
+@kernel
 def newton(method, st, sp, wk):
     """Newton's iteration from ``wk.x``: ``(status, iterations, CG iterations, envelope solves)``
     (status 0: converged, else a key of ``FAILURES``)."""
@@ -134,6 +151,10 @@ def newton(method, st, sp, wk):
     goal = method.solver.newton_tol * (st.gravity + st.radius / (h * h))
     mass = st.problem.model.mass
     cg_total = envelope_solves = 0
+    previous = math.inf
+    lightest = math.inf
+    for i in range(mass.shape[0]):
+        lightest = min(lightest, mass[i])
     e = increment.incremental(method, st, sp, wk.x, wk)
     for iteration in range(method.solver.newton_max_iter + 1):
         increment.incremental_gradient(method, st, sp, wk.x, wk, wk.grad, wk.blocks)
@@ -144,7 +165,11 @@ def newton(method, st, sp, wk):
             return 0, iteration, cg_total, envelope_solves
         if iteration == method.solver.newton_max_iter:
             break
-        iterations = increment.direction(st, sp, wk.x, wk.grad, wk.blocks, wk, wk.dx)
+        # the envelope's fallback changes the element matrices: new ones after it
+        fresh = iteration == 0 or envelope_solves > 0 or residual > LAG_CONTRACTION * previous
+        previous = residual
+        rtol = _forcing(wk.grad, goal * lightest)
+        iterations = increment.direction(st, sp, wk.x, wk.grad, wk.blocks, wk, wk.dx, fresh, rtol)
         if iterations == -2:
             return 3, iteration, cg_total, envelope_solves
         cg_total += max(iterations, 0)
@@ -254,7 +279,8 @@ def incremental_gradient(method: Integrator, st: ShellStep, sp: Start, x1: F64) 
 def direction(st: ShellStep, sp: Start, x1: F64, grad: F64, blocks: F64) -> tuple[F64, int]:
     """Newton's correction (m) at ``x1`` and the CG iterations (-1: the envelope solved it)."""
     dx = np.zeros_like(x1)
-    iterations = increment.direction(st, sp, np.ascontiguousarray(x1), grad, blocks.copy(), st.work, dx)
+    x1 = np.ascontiguousarray(x1)
+    iterations = increment.direction(st, sp, x1, grad, blocks, st.work, dx, True, 1e-5)
     if iterations == -2:
         raise StepFailure(FAILURES[3])
     return dx, int(iterations)

@@ -20,7 +20,7 @@ import math
 
 from ..physics.base.jit import kernel
 from ..physics.step import integrator
-from . import damping, friction, ground, potential, stepsolve
+from . import damping, friction, gas, ground, potential, stepsolve
 
 
 @kernel
@@ -119,15 +119,24 @@ def incremental_gradient(method, st, sp, x1, wk, grad, blocks):
 
 
 @kernel
-def direction(st, sp, x1, grad, blocks, wk, dx):
-    """Newton's correction (m) into ``dx`` from the gradient and contact blocks at ``x1``; returns
-    the CG iterations, -1 when the envelope solved it, -2 when its matrix was not positive definite."""
+def direction(st, sp, x1, grad, blocks, wk, dx, fresh, rtol):
+    """Newton's correction (m) into ``dx`` from the gradient and contact blocks at ``x1``, with the
+    skin's element matrices taken at ``x1`` if ``fresh``, else those assembled at an earlier
+    iterate (the mass term, the gas's rank-one term and the contact blocks are always those of
+    ``x1``), solved to a residual of ``rtol`` of the gradient (stepsolve.py); returns the CG
+    iterations, -1 when the envelope solved it, -2 when its matrix was not positive definite."""
     p, c_m, c_x, c_v = st.problem, sp.coef[1], sp.coef[2], sp.coef[3]
     _force_point(sp, x1, wk.xa)
-    s = c_x * potential.hessian(p.model, p.ws, wk.xa)
+    if fresh:
+        s = c_x * potential.hessian(p.model, p.ws, wk.xa)
+    else:
+        s = c_x * gas.gas_stiffness(p.model, gas.volume(wk.xa, p.model.triangles))
+        gas.volume_gradient(wk.xa, p.model.triangles, p.ws.dvol)
     for i in range(x1.shape[0]):
         for c in range(3):
             wk.rhs[i, c] = -grad[i, c]
         wk.mass_term[i] = (c_m + st.damping * c_v) * p.model.mass[i]
-    d = st.damping * c_v
-    return stepsolve.solve(p, st.owners, st.op, c_x, s, blocks, wk.mass_term, d, sp.basis, wk.rhs, dx, wk.cg)
+    coefficients = (c_x, s, st.damping * c_v, rtol)
+    return stepsolve.solve(
+        p, st.owners, st.op, coefficients, blocks, wk.mass_term, sp.basis, wk.rhs, dx, wk.cg, fresh
+    )

@@ -3,14 +3,16 @@
 faster than the envelope factorisation at ``h = 1e-4 s``).
 
 The matrix (N/m) is ``A = c_x sum_e K_e + blocks + diag(D) + s u u^T - d W^T W``: element matrices
-(triangles, hinges, scaled by ``c_x``), 3 x 3 vertex blocks (grounds' barriers, friction), a
-diagonal (the mass term), the gas's rank-one term (``s`` Pa/m^3, ``u = dV/dx``) and the damping's
-rank-6 term (``d`` 1/s^2 times ``W`` of damping.py); every degree of freedom is free (a step fixes
-none). It is assembled as a block-sparse matrix (blocks.py) and solved by Jacobi-preconditioned CG
-(cg.py) to a residual of ``CG_RTOL`` of the right-hand side (an inexact Newton direction: Newton's
-own test on the gradient sets the accuracy); if CG does not get there within ``CG_MAX_ITER``
-iterations, the envelope Cholesky with Sherman-Morrison solves the matrix without the rank-6 term
-(still symmetric positive definite, so Newton's direction stays one of descent).
+(triangles, hinges, scaled by ``c_x``; they may be an earlier iterate's, see implicit.py), 3 x 3
+vertex blocks (grounds' barriers, friction), a diagonal (the mass term), the gas's rank-one term
+(``s`` Pa/m^3, ``u = dV/dx``) and the damping's rank-6 term (``d`` 1/s^2 times ``W`` of
+damping.py); every degree of freedom is free (a step fixes none). It is a block-sparse matrix
+(blocks.py) with the vertex blocks and low-rank terms apart (cg.Operator), solved by
+Jacobi-preconditioned CG (cg.py) to a residual of ``rtol`` of the right-hand side, set by the
+Newton iteration (an inexact Newton direction: Newton's own test on the gradient sets the
+accuracy); if CG does not get there within ``CG_MAX_ITER`` iterations, the envelope Cholesky with
+Sherman-Morrison solves the matrix without the rank-6 term (still symmetric positive definite, so
+Newton's direction stays one of descent).
 """
 
 import numpy as np
@@ -19,7 +21,6 @@ from numpy.typing import NDArray
 from ..physics.base.jit import kernel
 from . import blocks, cg, envelope
 
-CG_RTOL = 1e-5
 CG_MAX_ITER = 400
 RANK = 7  # the operator's low-rank terms: the gas's and the damping's six
 
@@ -55,13 +56,15 @@ def _scale(mats, factor):
 
 
 @kernel
-def _envelope_solve(problem, owners, c_x, s, vertex_blocks, diagonal, rhs, out, z):
-    """The fallback (module doc): True if the matrix without the damping term was factorised."""
+def _envelope_solve(problem, owners, c_x, s, vertex_blocks, rhs, out, z, zero):
+    """The fallback (module doc): True if the matrix without the damping term was factorised. The
+    workspace's element matrices are left scaled, with the vertex blocks folded in."""
     m, ws, free = problem.model, problem.ws, problem.free
     _scale(ws.tri_hess, c_x)
     _scale(ws.hinge_hess, c_x)
     fold_blocks(ws.tri_hess, owners[0], owners[1], vertex_blocks)
-    envelope.assemble(problem.env, m.triangles, ws.tri_hess, m.hinges, ws.hinge_hess, diagonal, free)
+    zero[:] = 0.0
+    envelope.assemble(problem.env, m.triangles, ws.tri_hess, m.hinges, ws.hinge_hess, zero, free)
     if not envelope.cholesky(problem.env):
         return False
     envelope.solve_rank_one(problem.env, free, s, ws.dvol, rhs, out, z)
@@ -69,17 +72,22 @@ def _envelope_solve(problem, owners, c_x, s, vertex_blocks, diagonal, rhs, out, 
 
 
 @kernel
-def solve(problem, owners, op, c_x, s, vertex_blocks, mass_term, d, basis, rhs, out, work):
+def solve(problem, owners, op, coefficients, contact_blocks, mass_term, basis, rhs, out, work, assemble):
     """``out = A^-1 rhs`` (module doc) with the element matrices (unscaled) and ``dV/dx`` in the
-    workspace of ``problem`` (equilibrium.Problem), the vertex blocks (V, 3, 3), the diagonal
-    ``mass_term`` (V,) per vertex and the rank-6 ``basis`` (6, V, 3) or (0, V, 3). Returns the CG
-    iterations, -1 when the envelope solved it, -2 when that matrix was not positive definite."""
+    workspace of ``problem`` (equilibrium.Problem), assembled into ``op`` if ``assemble`` (else
+    those assembled before), ``coefficients = (c_x, s, d, CG's rtol)``, the contact's vertex blocks
+    (V, 3, 3), the diagonal ``mass_term`` (V,) per vertex and the rank-6 ``basis`` (6, V, 3) or
+    (0, V, 3). Returns the CG iterations, -1 when the envelope solved it (the workspace's element
+    matrices are then changed), -2 when that matrix was not positive definite."""
     ws = problem.ws
-    blocks.assemble(op.pattern, ws.tri_hess, ws.hinge_hess, c_x, vertex_blocks, op.values)
+    c_x, s, d, rtol = coefficients
+    if assemble:
+        blocks.assemble(op.pattern, ws.tri_hess, ws.hinge_hess, c_x, op.values)
     for v in range(rhs.shape[0]):
-        for c in range(3):
-            op.diagonal[v, c] = mass_term[v]
-            op.vectors[0, v, c] = ws.dvol[v, c]
+        for a in range(3):
+            for b in range(3):
+                op.vertex_blocks[v, a, b] = contact_blocks[v, a, b] + (mass_term[v] if a == b else 0.0)
+            op.vectors[0, v, a] = ws.dvol[v, a]
     op.weights[:] = 0.0
     op.weights[0] = s
     for k in range(basis.shape[0]):
@@ -87,9 +95,9 @@ def solve(problem, owners, op, c_x, s, vertex_blocks, mass_term, d, basis, rhs, 
         for v in range(rhs.shape[0]):
             for c in range(3):
                 op.vectors[1 + k, v, c] = basis[k, v, c]
-    iterations = cg.pcg(op, problem.free, rhs, out, work, CG_RTOL, CG_MAX_ITER)
+    iterations = cg.pcg(op, problem.free, rhs, out, work, rtol, CG_MAX_ITER)
     if iterations >= 0:
         return iterations
-    if _envelope_solve(problem, owners, c_x, s, vertex_blocks, op.diagonal, rhs, out, work[0]):
+    if _envelope_solve(problem, owners, c_x, s, op.vertex_blocks, rhs, out, work[0], work[1]):
         return -1
     return -2

@@ -63,9 +63,9 @@ def operator(model, ws, s, diagonal):
     """The system's cg.Operator: the element matrices assembled, the diagonal and the gas term."""
     pattern = blocks.block_pattern(len(model.rest), model.triangles, model.hinges)
     op = cg.make_operator(pattern, 1)
-    no_blocks = np.zeros((len(model.rest), 3, 3))
-    blocks.assemble(pattern, ws.tri_hess, ws.hinge_hess, 1.0, no_blocks, op.values)
-    op.diagonal[:] = diagonal
+    blocks.assemble(pattern, ws.tri_hess, ws.hinge_hess, 1.0, op.values)
+    for c in range(3):
+        op.vertex_blocks[:, c, c] = diagonal[:, c]
     op.vectors[0] = ws.dvol
     op.weights[0] = s
     return op
