@@ -2,7 +2,7 @@
 
 An icosphere mesh (mesh.py); St. Venant-Kirchhoff membrane triangles (membrane.py); discrete-shell
 hinge bending (bending.py); the enclosed gas (gas.py); their total potential (potential.py); the
-envelope Cholesky of its Hessian (envelope.py) and Jacobi-preconditioned CG (cg.py); static
+envelope Cholesky of its Hessian (envelope.py) and block-Jacobi-preconditioned CG (cg.py); static
 equilibrium (equilibrium.py) and linear vibration modes (modes.py). The dynamics: the validated
 descriptions ``Shell``, ``Ground``, ``Scene`` (scene.py); grounds' barriers (ground.py), lagged
 Coulomb friction (friction.py) and damping of the deformation only (damping.py); the implicit

@@ -44,8 +44,8 @@ F64 = NDArray[np.float64]
 FRICTION_LAGS = 3  # updates of the lagged normal forces within a step
 LAG_TOL = 1e-3  # their change (relative to the weight) that asks for another
 FORCING = 0.25  # a Newton direction's linear residual against the force Newton's test asks for
-CG_RTOL_MIN = 1e-8  # its bounds relative to the gradient
-CG_RTOL_MAX = 1e-2
+CG_RTOL_MIN = 1e-8  # its bounds relative to the gradient (stepsolve.py)
+CG_RTOL_MAX = 1e-5
 LAG_CONTRACTION = 0.1  # a Newton residual above this fraction of the last asks for new element matrices
 FAILURES = {
     1: "a non-finite gradient",
@@ -134,8 +134,8 @@ def _residual(grad, mass):
 def _forcing(grad, force_goal):
     """CG's relative tolerance for a Newton direction from the gradient ``grad`` (N): a residual of
     ``FORCING`` times the force ``force_goal`` (N) that Newton's test asks for, within
-    ``[CG_RTOL_MIN, CG_RTOL_MAX]`` (a linear residual below the test's needs no further iteration;
-    one far below the error of the linearisation is wasted)."""
+    ``[CG_RTOL_MIN, CG_RTOL_MAX]``: near convergence the linear residual is what is left of the
+    gradient, the rigid motion's part included, which nothing else corrects."""
     norm = 0.0
     for i in range(grad.shape[0]):
         for c in range(3):
@@ -280,7 +280,8 @@ def direction(st: ShellStep, sp: Start, x1: F64, grad: F64, blocks: F64) -> tupl
     """Newton's correction (m) at ``x1`` and the CG iterations (-1: the envelope solved it)."""
     dx = np.zeros_like(x1)
     x1 = np.ascontiguousarray(x1)
-    iterations = increment.direction(st, sp, x1, grad, blocks, st.work, dx, True, 1e-5)
+    st.work.bending_age[0] = -1
+    iterations = increment.direction(st, sp, x1, grad, blocks, st.work, dx, True, CG_RTOL_MAX)
     if iterations == -2:
         raise StepFailure(FAILURES[3])
     return dx, int(iterations)

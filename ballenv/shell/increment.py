@@ -21,6 +21,9 @@ import math
 from ..physics.base.jit import kernel
 from ..physics.step import integrator
 from . import damping, friction, gas, ground, potential, stepsolve
+from .bending import bending_hessians
+
+BENDING_AGE = 8  # fresh assemblies that keep the hinges' matrices
 
 
 @kernel
@@ -120,15 +123,23 @@ def incremental_gradient(method, st, sp, x1, wk, grad, blocks):
 
 @kernel
 def direction(st, sp, x1, grad, blocks, wk, dx, fresh, rtol):
-    """Newton's correction (m) into ``dx`` from the gradient and contact blocks at ``x1``, with the
-    skin's element matrices taken at ``x1`` if ``fresh``, else those assembled at an earlier
-    iterate (the mass term, the gas's rank-one term and the contact blocks are always those of
-    ``x1``), solved to a residual of ``rtol`` of the gradient (stepsolve.py); returns the CG
-    iterations, -1 when the envelope solved it, -2 when its matrix was not positive definite."""
+    """Newton's correction (m) into ``dx`` from the gradient and contact blocks at ``x1``, solved to
+    a residual of ``rtol`` of the gradient (stepsolve.py). The skin's element matrices are those of
+    ``x1`` if ``fresh``, else those assembled at an earlier iterate; the hinges' (bending, about
+    1e-3 of the matrix's diagonal on the default ball at its steps) are kept for up to
+    ``BENDING_AGE`` fresh assemblies (``wk.bending_age``; -1: none kept). The mass term, the gas's
+    rank-one term and the contact blocks are always those of ``x1``. Returns the CG iterations, -1
+    when the envelope solved it, -2 when its matrix was not positive definite."""
     p, c_m, c_x, c_v = st.problem, sp.coef[1], sp.coef[2], sp.coef[3]
     _force_point(sp, x1, wk.xa)
     if fresh:
-        s = c_x * potential.hessian(p.model, p.ws, wk.xa)
+        age = wk.bending_age
+        if age[0] < 0 or age[0] >= BENDING_AGE:
+            m = p.model
+            bending_hessians(wk.xa, m.hinges, m.theta0, m.weight, m.kb, p.ws.scratch, p.ws.hinge_hess)
+            age[0] = 0
+        age[0] += 1
+        s = c_x * potential.triangle_hessian(p.model, p.ws, wk.xa)
     else:
         s = c_x * gas.gas_stiffness(p.model, gas.volume(wk.xa, p.model.triangles))
         gas.volume_gradient(wk.xa, p.model.triangles, p.ws.dvol)
@@ -137,6 +148,9 @@ def direction(st, sp, x1, grad, blocks, wk, dx, fresh, rtol):
             wk.rhs[i, c] = -grad[i, c]
         wk.mass_term[i] = (c_m + st.damping * c_v) * p.model.mass[i]
     coefficients = (c_x, s, st.damping * c_v, rtol)
-    return stepsolve.solve(
+    iterations = stepsolve.solve(
         p, st.owners, st.op, coefficients, blocks, wk.mass_term, sp.basis, wk.rhs, dx, wk.cg, fresh
     )
+    if iterations < 0:
+        wk.bending_age[0] = -1  # the envelope's fallback scaled the element matrices
+    return iterations

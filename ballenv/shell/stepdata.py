@@ -48,6 +48,7 @@ class Work(NamedTuple):
     lam: F64  # (V, G) N
     cg: F64  # (4, V, 3) CG's scratch
     mass_term: F64  # (V,) N/m: the Newton matrix's diagonal per vertex
+    bending_age: NDArray[np.int64]  # (1,): fresh assemblies since the hinges' matrices, -1: none
     u3: F64  # (3,)
 
 
@@ -84,7 +85,7 @@ def make_work(n_vertices: int, n_grounds: int) -> Work:
     vectors = [z(v3) for _ in range(6)]
     return Work(
         *vectors, z(v3), z(b3), z(v3), z(b3), z(v3), z(v3), z(v3), z(v3), z((n_vertices, n_grounds)),
-        z((4,) + v3), z(n_vertices), z(3),
+        z((4,) + v3), z(n_vertices), np.full(1, -1, dtype=np.int64), z(3),
     )  # fmt: skip
 
 

@@ -8,7 +8,7 @@ vertex blocks (grounds' barriers, friction), a diagonal (the mass term), the gas
 (``s`` Pa/m^3, ``u = dV/dx``) and the damping's rank-6 term (``d`` 1/s^2 times ``W`` of
 damping.py); every degree of freedom is free (a step fixes none). It is a block-sparse matrix
 (blocks.py) with the vertex blocks and low-rank terms apart (cg.Operator), solved by
-Jacobi-preconditioned CG (cg.py) to a residual of ``rtol`` of the right-hand side, set by the
+block-Jacobi-preconditioned CG (cg.py) to a residual of ``rtol`` of the right-hand side, set by the
 Newton iteration (an inexact Newton direction: Newton's own test on the gradient sets the
 accuracy); if CG does not get there within ``CG_MAX_ITER`` iterations, the envelope Cholesky with
 Sherman-Morrison solves the matrix without the rank-6 term (still symmetric positive definite, so
