@@ -21,11 +21,14 @@ That equation is the stationarity of (J)::
 ``y = x0 + h v0 + h^2 ((1/2 - beta) - alpha_m beta / (1 - alpha_m)) a0``, whose Hessian (N/m)
 ``c_M M + c_x K(x_a) + Hess (B + D) + c c_v (M - W W^T)`` is symmetric and positive definite near a
 solution (increment.py). Newton's method starts from the predictor ``x0 + h v0 + h^2 a0 / 2`` (cut
-short of the grounds), solves with stepsolve.py, cuts each correction so that no vertex reaches a ground
-(ground.max_step) and halves it until ``Phi`` drops (Armijo) or, below ``Phi``'s rounding,
+short of the grounds), solves with stepsolve.py, cuts each correction so that no vertex reaches a
+ground (ground.max_step) and halves it until ``Phi`` drops (Armijo) or, below ``Phi``'s rounding,
 ``|grad Phi|`` does. It stops when every vertex's residual ``|grad Phi|_i / m_i`` is below
-``tol (|g| + R / h^2)`` (m/s^2); otherwise :class:`StepFailure` (the step is rejected). The step is
-one compiled call (:func:`step_kernel`) on the preallocated records of stepdata.py.
+``tol (|g| + R / h^2)`` (m/s^2); otherwise :class:`StepFailure` (the step is rejected). The skin's
+element matrices ``K`` are those of the step's first iterate, evaluated again only when an
+iteration lowered the residual by less than ``1 / LAG_CONTRACTION`` (the stopping test, not the
+matrix, sets the solution); CG's tolerance follows the force the test asks for (:func:`_forcing`).
+The step is one compiled call (:func:`step_kernel`) on the preallocated records of stepdata.py.
 """
 
 import math
