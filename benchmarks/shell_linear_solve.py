@@ -1,7 +1,8 @@
 """Options for the Newton linear solve of the 3-D shell, measured on the same systems: the envelope
 Cholesky after reverse Cuthill-McKee with the gas's rank-one term by Sherman-Morrison (kept,
-ballenv/shell/envelope.py), Jacobi-preconditioned CG applying the element matrices
-(ballenv/shell/cg.py), and a dense LU (LAPACK through NumPy's np.linalg.solve) as the reference.
+ballenv/shell/envelope.py), Jacobi-preconditioned CG on the element matrices assembled as a
+block-sparse matrix (ballenv/shell/cg.py, blocks.py; the assembly is in its time), and a dense LU
+(LAPACK through NumPy's np.linalg.solve) as the reference.
 
     python benchmarks/shell_linear_solve.py     # writes benchmarks/results/shell_linear_solve.md
 
@@ -28,7 +29,7 @@ import time  # noqa: E402
 import numpy as np  # noqa: E402
 
 from ballenv.files import write_text  # noqa: E402
-from ballenv.shell import Shell, cg, envelope, equilibrium, potential  # noqa: E402
+from ballenv.shell import Shell, blocks, cg, envelope, equilibrium, potential  # noqa: E402
 from ballenv.shell.equilibrium import determinate_support  # noqa: E402
 from ballenv.shell.model import build_model, build_workspace  # noqa: E402
 from ballenv.shell.modes import element_dofs  # noqa: E402
@@ -102,21 +103,18 @@ def measure(subdivisions, dt):
     t_solve = median_time(lambda: envelope.solve_rank_one(env, free, s, ws.dvol, rhs, out, z), 5 * repeats)
     err_env = float(np.abs(out - exact).max() / np.abs(exact).max())
     x_cg, work = np.zeros_like(rhs), np.zeros((4,) + rhs.shape)
-    args = (
-        model.triangles,
-        ws.tri_hess,
-        model.hinges,
-        ws.hinge_hess,
-        diagonal,
-        s,
-        ws.dvol,
-        free,
-        rhs,
-        x_cg,
-        work,
-    )
-    iterations = cg.pcg(*args, CG_RTOL, 100_000)
-    t_cg = median_time(lambda: cg.pcg(*args, CG_RTOL, 100_000), repeats)
+    op = cg.make_operator(blocks.block_pattern(len(model.rest), model.triangles, model.hinges), 1)
+    for c in range(3):
+        op.vertex_blocks[:, c, c] = diagonal[:, c]
+    op.vectors[0] = ws.dvol
+    op.weights[0] = s
+
+    def assemble_and_solve():
+        blocks.assemble(op.pattern, ws.tri_hess, ws.hinge_hess, 1.0, op.values)
+        return cg.pcg(op, free, rhs, x_cg, work, CG_RTOL, 100_000)
+
+    iterations = assemble_and_solve()
+    t_cg = median_time(assemble_and_solve, repeats)
     err_cg = float(np.abs(x_cg - exact).max() / np.abs(exact).max())
     return {
         "vertices": len(model.rest), "dofs": n, "envelope": env.values.size, "dense": t_dense,

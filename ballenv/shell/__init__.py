@@ -2,12 +2,14 @@
 
 An icosphere mesh (mesh.py); St. Venant-Kirchhoff membrane triangles (membrane.py); discrete-shell
 hinge bending (bending.py); the enclosed gas (gas.py); their total potential (potential.py); the
-envelope Cholesky of its Hessian (envelope.py) and Jacobi-preconditioned CG (cg.py); static
-equilibrium (equilibrium.py) and linear vibration modes (modes.py). The dynamics: the validated
-descriptions ``Shell``, ``Ground``, ``Scene`` (scene.py); grounds' barriers (ground.py), lagged
-Coulomb friction (friction.py) and damping of the deformation only (damping.py); the implicit
-step, backward Euler or generalized-alpha (implicit.py) and its linear solve (stepsolve.py);
-events (events.py); ``simulate`` and ``Trajectory`` (simulation.py). SI units.
+envelope Cholesky of its Hessian (envelope.py), its block-sparse assembly (blocks.py) and
+block-Jacobi-preconditioned CG (cg.py); static equilibrium (equilibrium.py) and linear vibration
+modes (modes.py). The dynamics: the validated descriptions ``Shell``, ``Ground``, ``Scene``
+(scene.py); grounds' barriers (ground.py), lagged Coulomb friction (friction.py) and damping of the
+deformation only (damping.py); the implicit step, backward Euler or generalized-alpha
+(implicit.py), its incremental potential (increment.py), its records (stepdata.py) and its linear
+solve (stepsolve.py); events (events.py); ``simulate`` and ``Trajectory`` (simulation.py). SI
+units.
 """
 
 from ..physics.base.compile_notice import install as _install_compile_notice

@@ -12,30 +12,71 @@ energy at ``2 R``. The step takes ``W`` at its start (``x0``): the damping matri
 ``c M`` less a rank-6 term.
 """
 
-import numpy as np
-from numpy.typing import NDArray
+import math
+
+from ..physics.base.jit import kernel
 
 
-def rigid_basis(x: NDArray[np.float64], mass: NDArray[np.float64]) -> NDArray[np.float64]:
-    """``W = M Q`` (6, V, 3) (kg^(1/2)) for positions ``x`` (V, 3) and lumped masses ``mass`` (V,)."""
-    centre = mass @ x / mass.sum()
-    r = x - centre
-    modes = np.zeros((6, len(x), 3))
-    for k in range(3):
-        modes[k, :, k] = 1.0
-        axis = np.zeros(3)
-        axis[k] = 1.0
-        modes[3 + k] = np.cross(axis, r)
-    flat = modes.reshape(6, -1)
-    m = np.repeat(mass, 3)
-    gram = (flat * m) @ flat.T
-    q = np.linalg.solve(np.linalg.cholesky(gram), flat)  # rows M-orthonormal
-    return (q * m).reshape(6, len(x), 3)
+@kernel
+def rigid_basis(x, mass, out):
+    """``W = M Q`` (6, V, 3) (kg^(1/2)) into ``out`` for positions ``x`` (V, 3) m and lumped masses
+    ``mass`` (V,) kg: the rigid modes (three translations, three spins about the centre of mass)
+    made M-orthonormal by Gram-Schmidt in the M inner product, in that order."""
+    total = 0.0
+    cx = cy = cz = 0.0
+    for i in range(x.shape[0]):
+        total += mass[i]
+        cx += mass[i] * x[i, 0]
+        cy += mass[i] * x[i, 1]
+        cz += mass[i] * x[i, 2]
+    centre = (cx / total, cy / total, cz / total)
+    for k in range(6):
+        for i in range(x.shape[0]):
+            for c in range(3):
+                out[k, i, c] = _mode(k, c, x[i, 0] - centre[0], x[i, 1] - centre[1], x[i, 2] - centre[2])
+        for j in range(k):  # q_k -= (q_j^T M q_k) q_j, with out[j] = M q_j
+            f = 0.0
+            for i in range(x.shape[0]):
+                for c in range(3):
+                    f += out[j, i, c] * out[k, i, c]
+            for i in range(x.shape[0]):
+                for c in range(3):
+                    out[k, i, c] -= f * out[j, i, c] / mass[i]
+        norm = 0.0
+        for i in range(x.shape[0]):
+            for c in range(3):
+                norm += mass[i] * out[k, i, c] * out[k, i, c]
+        scale = 1.0 / math.sqrt(norm)
+        for i in range(x.shape[0]):
+            for c in range(3):
+                out[k, i, c] *= scale * mass[i]
 
 
-def deformation_rate(
-    v: NDArray[np.float64], mass: NDArray[np.float64], basis: NDArray[np.float64]
-) -> NDArray[np.float64]:
-    """``(M - W W^T) v`` (V, 3) (kg m/s): the momentum of the velocity's non-rigid part."""
-    coefficients = basis.reshape(6, -1) @ v.reshape(-1)
-    return mass[:, None] * v - np.tensordot(coefficients, basis, axes=1)
+@kernel(inline="always")
+def _mode(k, c, rx, ry, rz):
+    """Component ``c`` of rigid mode ``k`` at the offset ``r`` from the centre: ``e_k`` (k < 3) or
+    ``e_(k-3) x r``."""
+    if k < 3:
+        return 1.0 if c == k else 0.0
+    a = k - 3
+    if a == 0:
+        return (0.0, -rz, ry)[c]
+    if a == 1:
+        return (rz, 0.0, -rx)[c]
+    return (-ry, rx, 0.0)[c]
+
+
+@kernel
+def deformation_rate(v, mass, basis, out):
+    """``(M - W W^T) v`` (V, 3) (kg m/s) into ``out``: the momentum of the velocity's non-rigid part."""
+    for i in range(v.shape[0]):
+        for c in range(3):
+            out[i, c] = mass[i] * v[i, c]
+    for k in range(basis.shape[0]):
+        f = 0.0
+        for i in range(v.shape[0]):
+            for c in range(3):
+                f += basis[k, i, c] * v[i, c]
+        for i in range(v.shape[0]):
+            for c in range(3):
+                out[i, c] -= f * basis[k, i, c]

@@ -20,26 +20,42 @@ That equation is the stationarity of (J)::
 
 ``y = x0 + h v0 + h^2 ((1/2 - beta) - alpha_m beta / (1 - alpha_m)) a0``, whose Hessian (N/m)
 ``c_M M + c_x K(x_a) + Hess (B + D) + c c_v (M - W W^T)`` is symmetric and positive definite near a
-solution. Newton's method starts from the predictor ``x0 + h v0 + h^2 a0 / 2`` (cut short of the
-grounds), solves with stepsolve.py, cuts each correction so that no vertex reaches a ground
-(ground.max_step) and halves it until ``Phi`` drops (Armijo) or, below ``Phi``'s rounding,
+solution (increment.py). Newton's method starts from the predictor ``x0 + h v0 + h^2 a0 / 2`` (cut
+short of the grounds), solves with stepsolve.py, cuts each correction so that no vertex reaches a
+ground (ground.max_step) and halves it until ``Phi`` drops (Armijo) or, below ``Phi``'s rounding,
 ``|grad Phi|`` does. It stops when every vertex's residual ``|grad Phi|_i / m_i`` is below
-``tol (|g| + R / h^2)`` (m/s^2); otherwise :class:`StepFailure` (the step is rejected).
+``tol (|g| + R / h^2)`` (m/s^2); otherwise :class:`StepFailure` (the step is rejected). The skin's
+element matrices ``K`` are those of the step's first iterate, evaluated again only when an
+iteration lowered the residual by less than ``1 / LAG_CONTRACTION`` (the stopping test, not the
+matrix, sets the solution); CG's tolerance follows the force the test asks for (:func:`_forcing`).
+The step is one compiled call (:func:`step_kernel`) on the preallocated records of stepdata.py.
 """
 
+import math
 from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
 
+from ..physics.base.jit import copy_into, kernel
 from ..physics.step import integrator
-from . import damping, envelope, friction, ground, potential, stepsolve
-from .equilibrium import ARMIJO, HALVINGS, Problem
-from .model import ShellModel, build_workspace
+from . import damping, ground, increment, potential
+from .equilibrium import ARMIJO, HALVINGS
+from .stepdata import ShellStep, Start, make_start
 
 F64 = NDArray[np.float64]
 FRICTION_LAGS = 3  # updates of the lagged normal forces within a step
 LAG_TOL = 1e-3  # their change (relative to the weight) that asks for another
+FORCING = 0.25  # a Newton direction's linear residual against the force Newton's test asks for
+CG_RTOL_MIN = 1e-8  # its bounds relative to the gradient (stepsolve.py)
+CG_RTOL_MAX = 1e-5
+LAG_CONTRACTION = 0.1  # a Newton residual above this fraction of the last asks for new element matrices
+FAILURES = {
+    1: "a non-finite gradient",
+    2: "no convergence within newton_max_iter Newton iterations",
+    3: "a Newton matrix that is not positive definite",
+    4: "a line search that found no descent",
+}  # the step kernel's status codes (0: converged)
 
 
 class StepFailure(RuntimeError):
@@ -64,144 +80,157 @@ def make_integrator(name: str, rho_infinity: float, tol: float, max_iter: int, d
     return Integrator(solver, ga)
 
 
-class ShellStep(NamedTuple):
-    """What the steps of one shell read (SI units)."""
-
-    problem: Problem  # loads: gravity m_i g (N)
-    gravity: float  # |g| m/s^2
-    normals: F64  # (G, 3) grounds' unit normals
-    heights: F64  # (G,) m
-    mu: F64  # (G,) friction coefficients
-    dhat: float  # m
-    kappa: float  # N/m
-    slip_speed: float  # eps_v m/s
-    damping: float  # c 1/s
-    owners: tuple[NDArray[np.int64], NDArray[np.int64]]  # stepsolve.block_owners
-    radius: float  # m
-
-
-def make_step(
-    model: ShellModel,
-    gravity: F64,
-    grounds: tuple[F64, F64, F64],
-    contact: tuple[float, float, float],
-    c: float,
-) -> ShellStep:
-    """The step data of ``model`` under ``gravity`` (3,) m/s^2, ``grounds`` (normals, heights, mu),
-    ``contact`` (dhat m, kappa N/m, eps_v m/s) and damping ``c`` (1/s)."""
-    loads = model.mass[:, None] * gravity[None, :]
-    env = envelope.build_envelope(len(model.rest), model.triangles, model.hinges)
-    free = np.ones(model.rest.shape, dtype=np.bool_)
-    problem = Problem(model, build_workspace(model), env, loads, free)
-    owners = stepsolve.block_owners(model.triangles, len(model.rest))
-    radius = float(np.linalg.norm(model.rest, axis=1).max())
-    return ShellStep(problem, float(np.linalg.norm(gravity)), *grounds, *contact, c, owners, radius)
-
-
-class Start(NamedTuple):
-    """A step's data fixed at its start."""
-
-    x0: F64
-    v0: F64
-    a0: F64  # zero for backward Euler
-    h: float
-    target: F64  # y (m)
-    coeffs: tuple[float, float, float]  # c_M 1/s^2, c_x, c_v 1/s
-    lam: F64  # (V, G) N, lagged normal forces
-    basis: F64  # (6, V, 3) damping's W at x0, or (0, V, 3)
-
-
-def start(method: Integrator, st: ShellStep, x0: F64, v0: F64, a0: F64, h: float) -> Start:
-    """The step's fixed data (module doc)."""
-    s = method.solver
-    c_m, c_x, c_v, am = integrator.coefficients(s, h)
-    a = a0 if method.generalized_alpha else np.zeros_like(a0)
-    shift = (0.5 - s.beta) - (am * s.beta / (1.0 - am) if method.generalized_alpha else 0.0)
-    target = x0 + h * v0 + h * h * shift * a
-    lam = np.zeros((len(x0), len(st.heights)))
-    ground.normal_forces(x0, st.normals, st.heights, st.dhat, st.kappa, lam)
-    mass = st.problem.model.mass
-    basis = damping.rigid_basis(x0, mass) if st.damping > 0.0 else np.zeros((0, len(x0), 3))
-    return Start(x0, v0, a, h, target, (c_m, c_x, c_v), lam, basis)
-
-
-def kinematics(method: Integrator, sp: Start, x1: F64) -> tuple[F64, F64, F64]:
-    """``(a1, v1, v_a)`` of the end positions ``x1`` (module doc)."""
-    s, h = method.solver, sp.h
-    a1 = (x1 - sp.x0 - h * sp.v0) / (s.beta * h * h) - (0.5 - s.beta) / s.beta * sp.a0
-    v1 = sp.v0 + h * ((1.0 - s.gamma) * sp.a0 + s.gamma * a1)
-    return a1, v1, (1.0 - s.alpha_f) * v1 + s.alpha_f * sp.v0
-
-
-def incremental(method: Integrator, st: ShellStep, sp: Start, x1: F64) -> float:
-    """Phi(x1) (J)."""
-    p, (c_m, c_x, c_v) = st.problem, sp.coeffs
-    m = p.model.mass[:, None]
-    total = 0.5 * c_m * float(np.sum(m * (x1 - sp.target) ** 2))
-    total += ground.barrier_energy(x1, st.normals, st.heights, st.dhat, st.kappa)
-    if not np.isfinite(total):
-        return float(total)
-    total += potential.energy(p.model, p.ws, sp.x0 + c_x * (x1 - sp.x0), p.loads) / c_x
-    e = st.slip_speed * sp.h
-    total += friction.friction_energy(x1, sp.x0, st.normals, sp.lam, st.mu, e, np.zeros(3))
-    if st.damping > 0.0:
-        va = kinematics(method, sp, x1)[2]
-        total += (
-            st.damping
-            / (2.0 * c_v)
-            * float(np.sum(va * damping.deformation_rate(va, p.model.mass, sp.basis)))
-        )
-    return total
-
-
-def contact_gradient(st: ShellStep, sp: Start, x1: F64, grad: F64, blocks: F64) -> None:
-    """Adds the barriers' and friction's gradient (N) and Hessian blocks (N/m) at ``x1``."""
-    ground.add_barrier(x1, st.normals, st.heights, st.dhat, st.kappa, grad, blocks)
-    e = st.slip_speed * sp.h
-    friction.add_friction(x1, sp.x0, st.normals, sp.lam, st.mu, e, grad, blocks, np.zeros(3))
-
-
-def incremental_gradient(method: Integrator, st: ShellStep, sp: Start, x1: F64) -> tuple[F64, F64]:
-    """``(grad Phi (N), the contact's Hessian blocks (V, 3, 3) N/m)`` at ``x1``."""
-    p, (c_m, c_x, _) = st.problem, sp.coeffs
-    grad = np.zeros_like(x1)
-    potential.gradient(p.model, p.ws, sp.x0 + c_x * (x1 - sp.x0), p.loads, grad)
-    grad += c_m * p.model.mass[:, None] * (x1 - sp.target)
-    if st.damping > 0.0:
-        grad += st.damping * damping.deformation_rate(kinematics(method, sp, x1)[2], p.model.mass, sp.basis)
-    blocks = np.zeros((len(x1), 3, 3))
-    contact_gradient(st, sp, x1, grad, blocks)
-    return grad, blocks
-
-
-def direction(st: ShellStep, sp: Start, x1: F64, grad: F64, blocks: F64, work: F64) -> tuple[F64, int]:
-    """Newton's correction (m) and the CG iterations (-1: the envelope solved it)."""
-    p, (c_m, c_x, c_v) = st.problem, sp.coeffs
-    ws = p.ws
-    s = c_x * potential.hessian(p.model, ws, sp.x0 + c_x * (x1 - sp.x0))
-    ws.tri_hess[:] *= c_x
-    ws.hinge_hess[:] *= c_x
-    stepsolve.fold_blocks(ws.tri_hess, st.owners[0], st.owners[1], blocks)
-    diagonal = np.repeat(((c_m + st.damping * c_v) * p.model.mass)[:, None], 3, axis=1)
-    return stepsolve.solve(p, s, diagonal, st.damping * c_v, sp.basis, -grad, work)
-
-
-def search(method: Integrator, st: ShellStep, sp: Start, x: F64, dx: F64, grad: F64) -> F64:
-    """``x + alpha dx`` for the first accepted ``alpha`` (module doc)."""
-    e0 = incremental(method, st, sp, x)
-    slope = abs(float(np.sum(grad * dx)))
-    rounding = 1e-13 * (st.problem.model.absolute_pressure * st.problem.model.rest_volume + abs(e0))
-    g0 = np.abs(grad).max()
+@kernel
+def search(method, st, sp, wk, e0):
+    """Moves ``wk.x`` to ``x + alpha wk.dx`` for the first accepted ``alpha`` (module doc); returns
+    Phi there (J), or NaN if no ``alpha`` was accepted."""
+    x, dx, grad, trial = wk.x, wk.dx, wk.grad, wk.trial
+    slope = 0.0
+    g0 = 0.0
+    for i in range(x.shape[0]):
+        for c in range(3):
+            slope += grad[i, c] * dx[i, c]
+            g0 = max(g0, abs(grad[i, c]))
+    slope = abs(slope)
+    model = st.problem.model
+    rounding = 1e-13 * (model.absolute_pressure * model.rest_volume + abs(e0))
     alpha = ground.max_step(x, dx, st.normals, st.heights)
     for _ in range(HALVINGS):
-        trial = x + alpha * dx
-        e = incremental(method, st, sp, trial)
-        if e <= e0 - ARMIJO * alpha * slope:
-            return trial
-        if abs(e - e0) <= rounding and np.abs(incremental_gradient(method, st, sp, trial)[0]).max() < g0:
-            return trial
+        for i in range(x.shape[0]):
+            for c in range(3):
+                trial[i, c] = x[i, c] + alpha * dx[i, c]
+        e = increment.incremental(method, st, sp, trial, wk)
+        accept = e <= e0 - ARMIJO * alpha * slope
+        if not accept and abs(e - e0) <= rounding:
+            increment.incremental_gradient(method, st, sp, trial, wk, wk.trial_grad, wk.trial_blocks)
+            accept = _largest(wk.trial_grad) < g0
+        if accept:
+            copy_into(x, trial)
+            return e
         alpha *= 0.5
-    raise StepFailure(f"the step's line search found no descent (|grad| = {g0:.3e} N)")
+    return math.nan
+
+
+@kernel
+def _largest(a):
+    """The largest ``|a_ic|``."""
+    out = 0.0
+    for i in range(a.shape[0]):
+        for c in range(3):
+            out = max(out, abs(a[i, c]))
+    return out
+
+
+@kernel
+def _residual(grad, mass):
+    """The largest ``|grad_ic| / m_i`` (m/s^2), NaN if a component is not finite."""
+    worst = 0.0
+    for i in range(grad.shape[0]):
+        for c in range(3):
+            if not math.isfinite(grad[i, c]):
+                return math.nan
+            worst = max(worst, abs(grad[i, c]) / mass[i])
+    return worst
+
+
+@kernel
+def _forcing(grad, force_goal):
+    """CG's relative tolerance for a Newton direction from the gradient ``grad`` (N): a residual of
+    ``FORCING`` times the force ``force_goal`` (N) that Newton's test asks for, within
+    ``[CG_RTOL_MIN, CG_RTOL_MAX]``: near convergence the linear residual is what is left of the
+    gradient, the rigid motion's part included, which nothing else corrects."""
+    norm = 0.0
+    for i in range(grad.shape[0]):
+        for c in range(3):
+            norm += grad[i, c] * grad[i, c]
+    return min(CG_RTOL_MAX, max(CG_RTOL_MIN, FORCING * force_goal / math.sqrt(norm)))
+
+
+@kernel
+def newton(method, st, sp, wk):
+    """Newton's iteration from ``wk.x``: ``(status, iterations, CG iterations, envelope solves)``
+    (status 0: converged, else a key of ``FAILURES``)."""
+    h = sp.coef[0]
+    goal = method.solver.newton_tol * (st.gravity + st.radius / (h * h))
+    mass = st.problem.model.mass
+    cg_total = envelope_solves = 0
+    previous = math.inf
+    lightest = math.inf
+    for i in range(mass.shape[0]):
+        lightest = min(lightest, mass[i])
+    e = increment.incremental(method, st, sp, wk.x, wk)
+    for iteration in range(method.solver.newton_max_iter + 1):
+        increment.incremental_gradient(method, st, sp, wk.x, wk, wk.grad, wk.blocks)
+        residual = _residual(wk.grad, mass)
+        if math.isnan(residual):
+            return 1, iteration, cg_total, envelope_solves
+        if residual <= goal:
+            return 0, iteration, cg_total, envelope_solves
+        if iteration == method.solver.newton_max_iter:
+            break
+        # the envelope's fallback changes the element matrices: new ones after it
+        fresh = iteration == 0 or envelope_solves > 0 or residual > LAG_CONTRACTION * previous
+        previous = residual
+        rtol = _forcing(wk.grad, goal * lightest)
+        iterations = increment.direction(st, sp, wk.x, wk.grad, wk.blocks, wk, wk.dx, fresh, rtol)
+        if iterations == -2:
+            return 3, iteration, cg_total, envelope_solves
+        cg_total += max(iterations, 0)
+        envelope_solves += iterations == -1
+        e = search(method, st, sp, wk, e)
+        if math.isnan(e):
+            return 4, iteration, cg_total, envelope_solves
+    return 2, method.solver.newton_max_iter, cg_total, envelope_solves
+
+
+@kernel
+def _lag_changed(st, sp, wk, weight):
+    """The normal forces at ``wk.x`` into ``wk.lam``: True if one differs from the lagged ones by
+    more than ``LAG_TOL`` of ``weight`` (N)."""
+    ground.normal_forces(wk.x, st.normals, st.heights, st.dhat, st.kappa, wk.lam)
+    change = 0.0
+    for i in range(wk.lam.shape[0]):
+        for g in range(wk.lam.shape[1]):
+            change = max(change, abs(wk.lam[i, g] - sp.lam[i, g]))
+    return change > LAG_TOL * weight
+
+
+@kernel
+def step_kernel(method, st, x0, v0, a0, h):
+    """One step of ``h`` (s) from ``(x0, v0, a0)`` into ``st.work`` (``x``, ``v1``, ``a1``,
+    ``force``): ``(status, Newton iterations, CG iterations, envelope solves)`` (see :func:`step`)."""
+    sp, wk = st.start, st.work
+    increment.begin(method, st, x0, v0, a0, h, sp)
+    for i in range(x0.shape[0]):
+        for c in range(3):
+            wk.dx[i, c] = h * v0[i, c] + 0.5 * h * h * sp.a0[i, c]
+    alpha = ground.max_step(x0, wk.dx, st.normals, st.heights)
+    for i in range(x0.shape[0]):
+        for c in range(3):
+            wk.x[i, c] = x0[i, c] + alpha * wk.dx[i, c]
+    weight = st.problem.model.mass.sum() * max(st.gravity, 1.0)
+    frictional = False
+    for g in range(st.mu.shape[0]):
+        frictional |= st.mu[g] > 0.0
+    newton_total = cg_total = envelope_total = 0
+    for lag in range(FRICTION_LAGS + 1):
+        status, iterations, cg_iterations, envelope_solves = newton(method, st, sp, wk)
+        newton_total += iterations
+        cg_total += cg_iterations
+        envelope_total += envelope_solves
+        if status != 0:
+            return status, newton_total, cg_total, envelope_total
+        if not frictional or lag == FRICTION_LAGS or not _lag_changed(st, sp, wk, weight):
+            break
+        copy_into(sp.lam, wk.lam)
+    wk.force[:] = 0.0
+    wk.trial_blocks[:] = 0.0
+    increment.contact_gradient(st, sp, wk.x, wk.force, wk.trial_blocks, wk.u3)
+    for i in range(x0.shape[0]):
+        for c in range(3):
+            wk.force[i, c] = -wk.force[i, c]
+    increment.kinematics(method, sp, wk.x, wk.a1, wk.v1, wk.va)
+    return 0, newton_total, cg_total, envelope_total
 
 
 class StepResult(NamedTuple):
@@ -216,55 +245,49 @@ class StepResult(NamedTuple):
     envelope_solves: int
 
 
-def newton(method: Integrator, st: ShellStep, sp: Start, x: F64, work: F64) -> tuple[F64, int, int, int]:
-    """Newton's iteration from ``x``: ``(x1, iterations, CG iterations, envelope solves)``."""
-    goal = method.solver.newton_tol * (st.gravity + st.radius / (sp.h * sp.h))
-    mass = st.problem.model.mass[:, None]
-    cg_total = envelope_solves = 0
-    for iteration in range(method.solver.newton_max_iter + 1):
-        grad, blocks = incremental_gradient(method, st, sp, x)
-        if not np.all(np.isfinite(grad)):
-            break
-        if np.abs(grad / mass).max() <= goal:
-            return x, iteration, cg_total, envelope_solves
-        if iteration == method.solver.newton_max_iter:
-            break
-        try:
-            dx, cg_iterations = direction(st, sp, x, grad, blocks, work)
-        except np.linalg.LinAlgError as error:
-            raise StepFailure(str(error)) from error
-        cg_total += max(cg_iterations, 0)
-        envelope_solves += cg_iterations < 0
-        x = search(method, st, sp, x, dx, grad)
-    raise StepFailure(f"no step after {method.solver.newton_max_iter} Newton iterations")
-
-
 def step(method: Integrator, st: ShellStep, x0: F64, v0: F64, a0: F64, h: float) -> StepResult:
     """One step of ``h`` (s) from ``(x0, v0, a0)`` (module doc); :class:`StepFailure` if none.
 
     With friction, the normal forces are lagged as Incremental Potential Contact does: taken at
     ``x0``, then, up to ``FRICTION_LAGS`` times, at the solution, solving again while some normal
     force changed by more than ``LAG_TOL`` of the shell's weight."""
-    sp = start(method, st, x0, v0, a0, h)
-    guess = x0 + h * v0 + 0.5 * h * h * sp.a0
-    x = x0 + ground.max_step(x0, guess - x0, st.normals, st.heights) * (guess - x0)
-    work = np.zeros((4, len(x0), 3))
-    totals = np.zeros(3, dtype=np.int64)
-    weight = float(st.problem.model.mass.sum()) * max(st.gravity, 1.0)
-    for lag in range(FRICTION_LAGS + 1):
-        x, *counts = newton(method, st, sp, x, work)
-        totals += counts
-        if not np.any(st.mu > 0.0) or lag == FRICTION_LAGS:
-            break
-        lam = np.zeros_like(sp.lam)
-        ground.normal_forces(x, st.normals, st.heights, st.dhat, st.kappa, lam)
-        if np.abs(lam - sp.lam).max() <= LAG_TOL * weight:
-            break
-        sp = sp._replace(lam=lam)
-    force = np.zeros_like(x)
-    contact_gradient(st, sp, x, force, np.zeros((len(x), 3, 3)))
-    a1, v1, _ = kinematics(method, sp, x)
-    return StepResult(x, v1, a1, -force, int(totals[0]), int(totals[1]), int(totals[2]))
+    status, iterations, cg_iterations, envelope_solves = step_kernel(method, st, x0, v0, a0, h)
+    if status != 0:
+        raise StepFailure(f"the step of {h:.3e} s failed: {FAILURES[status]}")
+    wk = st.work
+    return StepResult(
+        wk.x.copy(), wk.v1.copy(), wk.a1.copy(), wk.force.copy(), iterations, cg_iterations, envelope_solves
+    )
+
+
+def start(method: Integrator, st: ShellStep, x0: F64, v0: F64, a0: F64, h: float) -> Start:
+    """A new ``Start`` of a step of ``h`` (s) from ``(x0, v0, a0)`` (increment.begin)."""
+    sp = make_start(len(x0), len(st.heights), st.damping > 0.0)
+    increment.begin(method, st, x0, v0, a0, h, sp)
+    return sp
+
+
+def incremental(method: Integrator, st: ShellStep, sp: Start, x1: F64) -> float:
+    """Phi(x1) (J) (increment.incremental)."""
+    return float(increment.incremental(method, st, sp, np.ascontiguousarray(x1), st.work))
+
+
+def incremental_gradient(method: Integrator, st: ShellStep, sp: Start, x1: F64) -> tuple[F64, F64]:
+    """``(grad Phi (N), the contact's Hessian blocks (V, 3, 3) N/m)`` at ``x1``."""
+    grad, blocks = np.zeros_like(x1), np.zeros((len(x1), 3, 3))
+    increment.incremental_gradient(method, st, sp, np.ascontiguousarray(x1), st.work, grad, blocks)
+    return grad, blocks
+
+
+def direction(st: ShellStep, sp: Start, x1: F64, grad: F64, blocks: F64) -> tuple[F64, int]:
+    """Newton's correction (m) at ``x1`` and the CG iterations (-1: the envelope solved it)."""
+    dx = np.zeros_like(x1)
+    x1 = np.ascontiguousarray(x1)
+    st.work.bending_age[0] = -1
+    iterations = increment.direction(st, sp, x1, grad, blocks, st.work, dx, True, CG_RTOL_MAX)
+    if iterations == -2:
+        raise StepFailure(FAILURES[3])
+    return dx, int(iterations)
 
 
 def initial_acceleration(st: ShellStep, x: F64, v: F64) -> F64:
@@ -274,7 +297,10 @@ def initial_acceleration(st: ShellStep, x: F64, v: F64) -> F64:
     potential.gradient(p.model, p.ws, x, p.loads, grad)
     ground.add_barrier(x, st.normals, st.heights, st.dhat, st.kappa, grad, np.zeros((len(x), 3, 3)))
     if st.damping > 0.0:
-        grad += st.damping * damping.deformation_rate(v, p.model.mass, damping.rigid_basis(x, p.model.mass))
+        basis, rate = np.zeros((6, len(x), 3)), np.zeros_like(x)
+        damping.rigid_basis(x, p.model.mass, basis)
+        damping.deformation_rate(v, p.model.mass, basis, rate)
+        grad += st.damping * rate
     return -grad / p.model.mass[:, None]
 
 

@@ -46,9 +46,18 @@ def hessian(model, ws, x):
     """The Hessian's element matrices into ``ws.tri_hess``, ``ws.hinge_hess`` and ``dV/dx`` into
     ``ws.dvol``; returns the weight ``s`` (Pa/m^3) of its rank-one part ``s dV dV^T``."""
     m = model
+    bending_hessians(x, m.hinges, m.theta0, m.weight, m.kb, ws.scratch, ws.hinge_hess)
+    return triangle_hessian(model, ws, x)
+
+
+@kernel
+def triangle_hessian(model, ws, x):
+    """The triangles' part of :func:`hessian` (stretching and the gas's ``-p d2V``) into
+    ``ws.tri_hess`` and ``dV/dx`` into ``ws.dvol``; returns ``s`` (Pa/m^3). The hinges' matrices
+    are left as they are."""
+    m = model
     vol = volume(x, m.triangles)
     membrane_hessians(x, m.triangles, m.beta, m.area, m.lam, m.mu, m.thickness, ws.scratch.f, ws.tri_hess)
     add_volume_hessians(x, m.triangles, -gauge_pressure(m, vol), ws.tri_hess)
-    bending_hessians(x, m.hinges, m.theta0, m.weight, m.kb, ws.scratch, ws.hinge_hess)
     volume_gradient(x, m.triangles, ws.dvol)
     return gas_stiffness(m, vol)

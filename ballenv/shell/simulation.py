@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..physics.step import integrator
-from . import events, ground, implicit
+from . import events, ground, implicit, stepdata
 from .equilibrium import equilibrium
 from .gas import gauge_pressure, volume
 from .model import build_model
@@ -70,7 +70,7 @@ class Trajectory:
         return np.array(rows, dtype=np.float64).reshape(-1, 2)
 
 
-def build(scene: Scene) -> tuple[implicit.Integrator, list[implicit.ShellStep]]:
+def build(scene: Scene) -> tuple[implicit.Integrator, list[stepdata.ShellStep]]:
     """The integrator and each shell's step data."""
     method = implicit.make_integrator(
         scene.integrator, scene.rho_infinity, scene.newton_tol, scene.newton_max_iter, scene.dt
@@ -84,7 +84,7 @@ def build(scene: Scene) -> tuple[implicit.Integrator, list[implicit.ShellStep]]:
         model = build_model(shell, scene.gas_exponent, scene.atmospheric_pressure)
         kappa = scene.contact_stiffness or shell.youngs_modulus * shell.thickness
         contact = (scene.contact_distance, kappa, scene.friction_velocity)
-        steps.append(implicit.make_step(model, g, (normals, heights, mu), contact, scene.damping))
+        steps.append(stepdata.make_step(model, g, (normals, heights, mu), contact, scene.damping))
     return method, steps
 
 
@@ -116,7 +116,7 @@ def initial_states(scene: Scene, x0: ArrayLike | None, v0: ArrayLike | None) -> 
 class Recorder:
     """The records of a run: every accepted step's end, or the multiples of ``output_dt``."""
 
-    def __init__(self, output_dt: float | None, steps: list[implicit.ShellStep]) -> None:
+    def __init__(self, output_dt: float | None, steps: list[stepdata.ShellStep]) -> None:
         self.output_dt, self.steps = output_dt, steps
         self.rows: list[tuple[float, F64, F64, F64, F64]] = []
         self.count = 0
@@ -154,7 +154,7 @@ class Recorder:
 
 
 def error_ratio(
-    scene: Scene, method: implicit.Integrator, steps: list[implicit.ShellStep], a0: F64, a1: F64, h: float
+    scene: Scene, method: implicit.Integrator, steps: list[stepdata.ShellStep], a0: F64, a1: F64, h: float
 ) -> float:
     """The largest over shells of ``RMS_i |e_i| / (rtol R)`` (module doc)."""
     c = integrator.error_coefficient(method.solver)
@@ -167,7 +167,7 @@ def error_ratio(
 
 
 def try_step(
-    method: implicit.Integrator, steps: list[implicit.ShellStep], state: tuple[F64, F64, F64], h: float
+    method: implicit.Integrator, steps: list[stepdata.ShellStep], state: tuple[F64, F64, F64], h: float
 ) -> list[implicit.StepResult]:
     """Every shell's step of ``h`` (s), or :class:`implicit.StepFailure`."""
     x, v, a = state

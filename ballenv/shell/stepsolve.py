@@ -2,14 +2,15 @@
 (``benchmarks/results/shell_linear_solve.md``: with the mass term ``M / h^2`` CG is 11-27 times
 faster than the envelope factorisation at ``h = 1e-4 s``).
 
-The matrix (N/m) is ``A = sum_e K_e + blocks + diag(D) + s u u^T - d W^T W``: element matrices
-(triangles, hinges), 3 x 3 vertex blocks (grounds' barriers, friction), a diagonal (the mass term),
-the gas's rank-one term (``s`` Pa/m^3, ``u = dV/dx``) and the damping's rank-6 term (``d`` 1/s^2
-times ``W`` of damping.py); every degree of freedom is free (a step fixes none). The vertex blocks
-are added to the diagonal block of one triangle of each vertex (exact). Jacobi-preconditioned CG
-applies it element by element (:func:`pcg`) to a residual of ``CG_RTOL`` of the right-hand side
-(an inexact Newton direction: Newton's own test on the gradient sets the accuracy); if it does
-not get there within ``CG_MAX_ITER`` iterations, the envelope Cholesky with
+The matrix (N/m) is ``A = c_x sum_e K_e + blocks + diag(D) + s u u^T - d W^T W``: element matrices
+(triangles, hinges, scaled by ``c_x``; they may be an earlier iterate's, see implicit.py), 3 x 3
+vertex blocks (grounds' barriers, friction), a diagonal (the mass term), the gas's rank-one term
+(``s`` Pa/m^3, ``u = dV/dx``) and the damping's rank-6 term (``d`` 1/s^2 times ``W`` of
+damping.py); every degree of freedom is free (a step fixes none). It is a block-sparse matrix
+(blocks.py) with the vertex blocks and low-rank terms apart (cg.Operator), solved by
+block-Jacobi-preconditioned CG (cg.py) to a residual of ``rtol`` of the right-hand side, set by the
+Newton iteration (an inexact Newton direction: Newton's own test on the gradient sets the
+accuracy); if CG does not get there within ``CG_MAX_ITER`` iterations, the envelope Cholesky with
 Sherman-Morrison solves the matrix without the rank-6 term (still symmetric positive definite, so
 Newton's direction stays one of descent).
 """
@@ -18,11 +19,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..physics.base.jit import kernel
-from . import envelope
-from .cg import _dot, matrix_diagonal
+from . import blocks, cg, envelope
 
-CG_RTOL = 1e-5
 CG_MAX_ITER = 400
+RANK = 7  # the operator's low-rank terms: the gas's and the damping's six
 
 
 def block_owners(
@@ -48,109 +48,56 @@ def fold_blocks(tri_mats, owner_tri, owner_corner, blocks):
                 tri_mats[t, c + a, c + b] += blocks[v, a, b]
 
 
-@kernel(fastmath=True)
-def _apply_elements(elements, mats, x, y, local):
-    """``y += sum_e K_e x_e`` with every degree of freedom free; ``local`` (12,) scratch."""
-    n = 3 * elements.shape[1]
-    for e in range(elements.shape[0]):
-        for i in range(n):
-            local[i] = x[elements[e, i // 3], i % 3]
-        for i in range(n):
-            s = 0.0
-            for j in range(n):
-                s += mats[e, i, j] * local[j]
-            y[elements[e, i // 3], i % 3] += s
+@kernel
+def _scale(mats, factor):
+    m = mats.reshape(mats.size)
+    for k in range(m.size):
+        m[k] *= factor
 
 
 @kernel
-def _apply(triangles, tri_mats, hinges, hinge_mats, diagonal, s, u, d, w, x, y, local):
-    """``y = A x`` (module doc) with every degree of freedom free."""
-    ux = 0.0
-    for v in range(x.shape[0]):
-        for c in range(3):
-            y[v, c] = diagonal[v, c] * x[v, c]
-            ux += u[v, c] * x[v, c]
-    _apply_elements(triangles, tri_mats, x, y, local)
-    _apply_elements(hinges, hinge_mats, x, y, local)
-    for v in range(x.shape[0]):
-        for c in range(3):
-            y[v, c] += s * ux * u[v, c]
-    for k in range(w.shape[0]):
-        wx = 0.0
-        for v in range(x.shape[0]):
-            for c in range(3):
-                wx += w[k, v, c] * x[v, c]
-        for v in range(x.shape[0]):
-            for c in range(3):
-                y[v, c] -= d * wx * w[k, v, c]
-
-
-@kernel
-def pcg(
-    triangles, tri_mats, hinges, hinge_mats, diagonal, s, u, d, w, free, rhs, x, work, local, rtol, max_iter
-):
-    """Jacobi-preconditioned CG on ``A x = rhs`` (module doc) from ``x = 0``, every degree of
-    freedom free; ``work`` (4, V, 3) and ``local`` (12,) scratch. Returns the iterations taken, or
-    -1 if ``max_iter`` was reached first."""
-    r, p, q, dinv = work[0], work[1], work[2], work[3]
-    matrix_diagonal(triangles, tri_mats, hinges, hinge_mats, diagonal, s, u, dinv)
-    for k in range(w.shape[0]):
-        for v in range(x.shape[0]):
-            for c in range(3):
-                dinv[v, c] -= d * w[k, v, c] * w[k, v, c]
-    for v in range(x.shape[0]):
-        for c in range(3):
-            dinv[v, c] = 1.0 / dinv[v, c] if free[v, c] else 0.0
-            x[v, c] = 0.0
-            r[v, c] = rhs[v, c] if free[v, c] else 0.0
-            p[v, c] = dinv[v, c] * r[v, c]
-    goal = rtol * np.sqrt(_dot(r, r, free))
-    rz = _dot(r, p, free)
-    for it in range(max_iter):
-        if np.sqrt(_dot(r, r, free)) <= goal:
-            return it
-        _apply(triangles, tri_mats, hinges, hinge_mats, diagonal, s, u, d, w, p, q, local)
-        alpha = rz / _dot(p, q, free)
-        rz_new = 0.0
-        for v in range(x.shape[0]):
-            for c in range(3):
-                x[v, c] += alpha * p[v, c]
-                r[v, c] -= alpha * q[v, c]
-                rz_new += r[v, c] * dinv[v, c] * r[v, c]
-        beta = rz_new / rz
-        rz = rz_new
-        for v in range(x.shape[0]):
-            for c in range(3):
-                p[v, c] = dinv[v, c] * r[v, c] + beta * p[v, c]
-    return -1
-
-
-def solve(problem, s, diagonal, d, w, rhs, work):
-    """``A^-1 rhs`` (module doc) for ``problem`` (equilibrium.Problem) whose workspace holds the
-    element matrices with the vertex blocks folded in; ``(solution, CG iterations or -1 when the
-    envelope solved it)``."""
+def _envelope_solve(problem, owners, c_x, s, vertex_blocks, rhs, out, z, zero):
+    """The fallback (module doc): True if the matrix without the damping term was factorised. The
+    workspace's element matrices are left scaled, with the vertex blocks folded in."""
     m, ws, free = problem.model, problem.ws, problem.free
-    out = np.zeros_like(rhs)
-    args = (
-        m.triangles,
-        ws.tri_hess,
-        m.hinges,
-        ws.hinge_hess,
-        diagonal,
-        s,
-        ws.dvol,
-        d,
-        w,
-        free,
-        rhs,
-        out,
-        work,
-    )
-    iterations = pcg(*args, np.zeros(12), CG_RTOL, CG_MAX_ITER)
-    if iterations >= 0:
-        return out, iterations
-    envelope.assemble(problem.env, m.triangles, ws.tri_hess, m.hinges, ws.hinge_hess, diagonal, free)
+    _scale(ws.tri_hess, c_x)
+    _scale(ws.hinge_hess, c_x)
+    fold_blocks(ws.tri_hess, owners[0], owners[1], vertex_blocks)
+    zero[:] = 0.0
+    envelope.assemble(problem.env, m.triangles, ws.tri_hess, m.hinges, ws.hinge_hess, zero, free)
     if not envelope.cholesky(problem.env):
-        raise np.linalg.LinAlgError("the step's matrix is not positive definite")
-    envelope.solve_rank_one(problem.env, free, s, ws.dvol, rhs, out, np.zeros_like(rhs))
-    return out, -1
+        return False
+    envelope.solve_rank_one(problem.env, free, s, ws.dvol, rhs, out, z)
+    return True
+
+
+@kernel
+def solve(problem, owners, op, coefficients, contact_blocks, mass_term, basis, rhs, out, work, assemble):
+    """``out = A^-1 rhs`` (module doc) with the element matrices (unscaled) and ``dV/dx`` in the
+    workspace of ``problem`` (equilibrium.Problem), assembled into ``op`` if ``assemble`` (else
+    those assembled before), ``coefficients = (c_x, s, d, CG's rtol)``, the contact's vertex blocks
+    (V, 3, 3), the diagonal ``mass_term`` (V,) per vertex and the rank-6 ``basis`` (6, V, 3) or
+    (0, V, 3). Returns the CG iterations, -1 when the envelope solved it (the workspace's element
+    matrices are then changed), -2 when that matrix was not positive definite."""
+    ws = problem.ws
+    c_x, s, d, rtol = coefficients
+    if assemble:
+        blocks.assemble(op.pattern, ws.tri_hess, ws.hinge_hess, c_x, op.values)
+    for v in range(rhs.shape[0]):
+        for a in range(3):
+            for b in range(3):
+                op.vertex_blocks[v, a, b] = contact_blocks[v, a, b] + (mass_term[v] if a == b else 0.0)
+            op.vectors[0, v, a] = ws.dvol[v, a]
+    op.weights[:] = 0.0
+    op.weights[0] = s
+    for k in range(basis.shape[0]):
+        op.weights[1 + k] = -d
+        for v in range(rhs.shape[0]):
+            for c in range(3):
+                op.vectors[1 + k, v, c] = basis[k, v, c]
+    iterations = cg.pcg(op, problem.free, rhs, out, work, rtol, CG_MAX_ITER)
+    if iterations >= 0:
+        return iterations
+    if _envelope_solve(problem, owners, c_x, s, op.vertex_blocks, rhs, out, work[0], work[1]):
+        return -1
+    return -2
