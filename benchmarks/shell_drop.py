@@ -171,7 +171,7 @@ def table(rows: list[dict]) -> str:
         f"| {100 * r['apex_error']:+.2f} % | {r['apexes']} | {r['touchdowns']} | {r['steps']} "
         f"| {r['rejections']} | {r['newton']} | {r['newton'] / r['steps']:.2f} "
         f"| {r['cg']} | {r['envelope']} | {1e3 * r['wall'] / r['steps']:.2f} "
-        f"| {r['old_wall_per_step'] * 1e3:.2f} | {r['speedup']:.2f} |\n".replace("| nan |", "| - |")
+        f"| {r['old_wall_per_step'] * 1e3:.2f} | {r['speedup']:.2f} |\n".replace(" nan ", " - ")
         for r in rows
     )
     return head + body
