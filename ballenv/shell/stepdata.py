@@ -82,9 +82,9 @@ def make_work(n_vertices: int, n_grounds: int) -> Work:
     """A zero ``Work`` for a shell of ``n_vertices`` over ``n_grounds`` grounds."""
     z = np.zeros
     v3, b3 = (n_vertices, 3), (n_vertices, 3, 3)
-    vectors = [z(v3) for _ in range(6)]
     return Work(
-        *vectors, z(v3), z(b3), z(v3), z(b3), z(v3), z(v3), z(v3), z(v3), z((n_vertices, n_grounds)),
+        z(v3), z(v3), z(v3), z(v3), z(v3), z(v3),
+        z(v3), z(b3), z(v3), z(b3), z(v3), z(v3), z(v3), z(v3), z((n_vertices, n_grounds)),
         z((4,) + v3), z(n_vertices), np.full(1, -1, dtype=np.int64), z(3),
     )  # fmt: skip
 

@@ -19,10 +19,11 @@ links that IR. The environment pointer numba stores in a library's module (excep
 stored when that module reaches the engine (:func:`_set_env`).
 """
 
-import llvmlite.binding as ll
+import llvmlite.binding as ll  # type: ignore[import-untyped]
 from numba.core import codegen
 
-_waiting_envs = {}  # environment global name -> numba Environment, set once a module defines it
+# environment global name -> numba Environment, set once a module in the engine defines the global
+_waiting_envs: dict[str, object] = {}
 
 
 class LazyLibrary(codegen.JITCodeLibrary):
