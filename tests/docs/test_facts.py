@@ -112,7 +112,7 @@ FACTS = {
     "cold start, quick start": ("docs/quickstart.md", r"its first steps took\s+([\d.]+) s", cold_env),
     "cold start of simulate, quick start": (
         "docs/quickstart.md",
-        r"first `simulate\(\)` of one ring with `Scene`'s defaults ([\d.]+) s",
+        r"first `simulate\(\)` of one ring with `Scene`'s\s+defaults ([\d.]+) s",
         lambda hooks: results_cell(hooks, "cold_start.md", ("1",), "wall (s)", table=2),
     ),
     "pressure mode scores": (

@@ -27,7 +27,7 @@ def test_the_codegen_makes_lazy_libraries():
 def test_an_inner_kernel_stays_ir_and_its_caller_is_emitted_once_with_it_linked_in():
     assert polygon_area(SQUARE) == 1.0  # Python calls the twin, which calls next_node
     (callee,) = _libraries(next_node)
-    assert callee._deferred  # never optimised on its own, no machine code
+    assert callee._deferred  # optimised IR, no machine code of its own
     assert callee.get_pointer_to_function("no such wrapper") == 0 and callee._deferred
     (entry,) = _libraries(jit.python_entry(polygon_area))
     assert not entry._deferred  # optimised and emitted, with next_node linked in
