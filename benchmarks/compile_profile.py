@@ -7,7 +7,8 @@ Each scenario runs twice in the same minute: as the package compiles (machine co
 entry points Python calls, ``ballenv/physics/base/machine_code.py``) and with numba's own code
 library put back (every compiled function optimised and emitted on its own, as numba does by
 default), so the page shows what the lazy machine code saves as a ratio on the same machine. The
-libraries whose module LLVM optimised and turned into machine code are counted, with that time.
+libraries turned into machine code are counted; the LLVM time is every library's module optimisation
+plus that machine code.
 
 A pass's time is its own (s): a callee compiled while its caller is typed is counted to the
 callee. Per function: typing (numba's type inference passes), lowering (``native_lowering``: the
@@ -125,7 +126,7 @@ def summary(scenario, runs):
         f"## {scenario}",
         "",
         "| code library | wall (s) | numba's passes (s) | typing (s) | lowering (s) | libraries emitted "
-        "| their optimisation and machine code (s) |",
+        "| module optimisation and machine code (s) |",
         "|---|---:|---:|---:|---:|---:|---:|",
     ]
     for label, (wall, rows, backend) in runs.items():

@@ -7,6 +7,7 @@ import subprocess
 import sys
 
 import numpy as np
+from numba import types
 from numba.core import codegen
 
 from ballenv.physics.base import jit, machine_code
@@ -26,6 +27,7 @@ def test_the_codegen_makes_lazy_libraries():
 
 def test_an_inner_kernel_stays_ir_and_its_caller_is_emitted_once_with_it_linked_in():
     assert polygon_area(SQUARE) == 1.0  # Python calls the twin, which calls next_node
+    next_node.compile((types.int64, types.int64))  # compiled here, or loaded from the cache as IR
     (callee,) = _libraries(next_node)
     assert callee._deferred  # optimised IR, no machine code of its own
     assert callee.get_pointer_to_function("no such wrapper") == 0 and callee._deferred
