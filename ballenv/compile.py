@@ -42,8 +42,8 @@ def _rings_on_floor(n_rings):
     simulate(Scene(rings=rings, grounds=[Ground()]), t_end=0.02)
 
 
-# name -> (function, argument), longest first (measured on an empty cache: the joint step of two
-# rings compiles the most, then the env, then one ring)
+# name -> (function, argument), longest first: the joint step of two rings compiles the most, then
+# the env, then one ring (benchmarks/results/cold_start.md)
 JOBS = {
     "simulate, two rings on a floor": (_rings_on_floor, 2),
     "env, pressure mode": (_env, "pressure"),

@@ -1,6 +1,6 @@
 """The linear solve of a time step's Newton iteration, chosen by measurement
-(``benchmarks/results/shell_linear_solve.md``: with the mass term ``M / h^2`` CG is 11-27 times
-faster than the envelope factorisation at ``h = 1e-4 s``).
+(``benchmarks/results/shell_linear_solve.md``: with the mass term ``M / h^2`` CG against the
+envelope factorisation).
 
 The matrix (N/m) is ``A = c_x sum_e K_e + blocks + diag(D) + s u u^T - d W^T W``: element matrices
 (triangles, hinges, scaled by ``c_x``; they may be an earlier iterate's, see implicit.py), 3 x 3

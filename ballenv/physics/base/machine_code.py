@@ -6,7 +6,7 @@ library's module (the function with every callee linked into it) and emits its m
 a pointer to it exists. A caller then links the callee's optimised IR into its own library and does
 the same again: a callee at depth d of the call tree is emitted d + 1 times. The simulator's kernels
 are a deep tree that only a few entry points (:func:`.jit.python_entry`) are called through, so most
-of that machine code is thrown away (the env's first steps: 166 libraries, 5 of them entry points).
+of that machine code is thrown away (``benchmarks/results/compile_profile.md`` counts it).
 
 :class:`LazyLibrary` (installed as the CPU codegen's library class by :func:`install`) optimises a
 library's module as numba does (callees reach their callers optimised, so the entry points inline
