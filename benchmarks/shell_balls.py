@@ -3,7 +3,7 @@ rule's drop test, then what the balls predict, and the 3-D ball beside the ring 
 
     python benchmarks/shell_balls.py          # fits; writes benchmarks/results/shell_balls.md
     python benchmarks/shell_balls.py --check  # runs the presets as they are (no fit)
-    python benchmarks/shell_balls.py --fine   # also the 642-vertex drops (about 5 minutes more)
+    python benchmarks/shell_balls.py --fine   # also the 642-vertex fits and drops (about 10 minutes more)
 
 For each material, the deformation damping ``c`` (1/s) is the root of ``rebound(c) - target``
 (scipy's ``brentq``, to 0.5 1/s: about 0.5 mm of rebound) on the drop test of the ball it is fitted
@@ -13,7 +13,8 @@ they are: every ball's drop (its rule's, 2 m for the volleyball: rebound as the 
 restitution, contact time, peak force, wall time); the restitution against pressure (0.6-1.4 times
 the ball's) and against impact speed (3-9 m/s, the drop heights ``v^2 / (2 g)``); the ring's ball
 of the same name (``ballenv.balls``, its own calibration) dropped from the same height; with
-``--fine``, the same drops on 642 vertices with the damping fitted on 162.
+``--fine``, the same drops on 642 vertices with the damping fitted on 162, then with each
+material's damping fitted again on 642 (the volleyball with the leather's).
 """
 
 import os
@@ -50,10 +51,14 @@ def fit_damping(ball: balls.Ball) -> float:
     test = ball.drop_test
     assert test is not None
 
+    seen: dict[float, float] = {}  # brentq evaluates the bracket's ends again
+
     def miss(c: float) -> float:
-        result = balls.drop(ball, damping=c)
-        print(f"  {ball.name}: c = {c:.2f} 1/s -> rebound {result.rebound:.4f} m", flush=True)
-        return result.rebound - test.target
+        if c not in seen:
+            rebound = balls.drop(ball, damping=c).rebound
+            print(f"  {ball.name} ({ball.shell.n_vertices} vertices): c = {c:.2f} 1/s -> {rebound:.4f} m")
+            seen[c] = rebound - test.target
+        return seen[c]
 
     low, high = 100.0, 400.0
     while miss(low) < 0.0:
@@ -93,7 +98,7 @@ def drop_table(rows) -> list[str]:
         rule = f"{test.rebound[0]:.2f}-{test.rebound[1]:.2f} ({test.measured_to})" if test else "none"
         role = "fitted" if ball.material.fitted_on == ball.name else "predicted"
         lines.append(
-            f"| {ball.name} | {ball.material.name} | {ball.material.damping:.1f} | {role} "
+            f"| {ball.name} | {ball.material.name} | {ball.damping:.1f} | {role} "
             f"| {ball.pressure / 1e3:.1f} | {100 * ball.radius:.2f} | {1e3 * ball.mass:.1f} "
             f"| {1e3 * ball.shell.thickness:.2f} | {res.drop_height:.2f} | {res.rebound:.3f} | {rule} "
             f"| {res.restitution:.3f} | {1e3 * res.contact_time:.2f} | {1e3 * sphere_contact_time(ball):.2f} "
@@ -132,24 +137,48 @@ def ring_table(rows, ring_rows) -> list[str]:
             f"| {ball.name} | {res.drop_height:.2f} | {res.measured_to} | {res.rebound:.3f} "
             f"| {ring.rebound:.3f} "
             f"| {1e3 * res.contact_time:.2f} | {1e3 * ring.contact_time:.2f} | {res.peak_force:.0f} "
-            f"| {ring.peak_force:.0f} | {ball.material.damping:.1f} | {ring_ball.damping:.1f} |"
+            f"| {ring.peak_force:.0f} | {ball.damping:.1f} | {ring_ball.damping:.1f} |"
         )
     return lines
 
 
 def fine_table(rows, fine) -> list[str]:
     lines = [
-        "| ball | rebound, 162 vertices (m) | rebound, 642 vertices (m) | contact, 162 / 642 (ms) "
-        "| peak force, 162 / 642 (N) | wall, 642 (s) |",
-        "|---|---:|---:|---:|---:|---:|",
+        "| ball | c on 162 (1/s) | rebound, 162 (m) | rebound, 642, c on 162 (m) | c on 642 (1/s) "
+        "| rebound, 642, c on 642 (m) | rule (m) | contact, 162 / 642 (ms) | peak force, 162 / 642 (N) "
+        "| wall, 642 (s) |",
+        "|---|---:|---:|---:|---:|---:|---|---:|---:|---:|",
     ]
     for ball, res, _ in rows:
-        f, wall = fine[ball.name]
+        fine_c, refit = fine["fits"][ball.material.name], fine["refit"][ball.name]
+        same, wall = fine["same"][ball.name]
+        test = ball.drop_test
+        rule = f"{test.rebound[0]:.2f}-{test.rebound[1]:.2f}" if test else "none"
         lines.append(
-            f"| {ball.name} | {res.rebound:.3f} | {f.rebound:.3f} | {1e3 * res.contact_time:.2f} / "
-            f"{1e3 * f.contact_time:.2f} | {res.peak_force:.0f} / {f.peak_force:.0f} | {wall:.1f} |"
+            f"| {ball.name} | {ball.damping:.1f} | {res.rebound:.3f} | {same.rebound:.3f} "
+            f"| {fine_c:.1f} | {refit.rebound:.3f} | {rule} | {1e3 * res.contact_time:.2f} / "
+            f"{1e3 * refit.contact_time:.2f} | {res.peak_force:.0f} / {refit.peak_force:.0f} | {wall:.1f} |"
         )
     return lines
+
+
+def fine_runs() -> dict:
+    """The 642-vertex drops: with the damping fitted on 162 ("same", with wall times), each
+    material's damping fitted on 642 ("fits") and the drops with it ("refit")."""
+    made = {name: make(subdivisions=3) for name, make in balls.BALLS.items()}
+    same = {name: timed_drop(ball, damping=ball.material.damping[2]) for name, ball in made.items()}
+    fits = {mat: fit_damping(made[name]) for mat, name in FITTED_ON.items()}
+    refit = {name: balls.drop(ball, damping=fits[ball.material.name]) for name, ball in made.items()}
+    return {"same": same, "fits": fits, "refit": refit}
+
+
+def check_fits(fitted: dict[str, float], subdivisions: int) -> bool:
+    """Prints the fitted table; False where the presets' damping on that mesh differs from it."""
+    print(f"{subdivisions}: " + ", ".join(f'"{m}": {c:.1f}' for m, c in fitted.items()))
+    drift = {m: c for m, c in fitted.items() if abs(c - balls.FITTED_DAMPING[m][subdivisions]) > 0.5}
+    if drift:
+        print(f"the presets' damping on subdivisions {subdivisions} differs from the fit: {drift}")
+    return not drift
 
 
 def markdown(rows, pressure, speed, ring_rows, fine) -> str:
@@ -160,17 +189,21 @@ def markdown(rows, pressure, speed, ring_rows, fine) -> str:
     )
     materials = "\n".join(
         f"* **{m.name}**: E = {m.youngs_modulus / 1e6:g} MPa, nu = {m.poisson_ratio:g}, rho = {m.density:g}"
-        f" kg/m^3 ({m.source}); c = {m.damping:.1f} 1/s fitted on the {m.fitted_on}'s drop test."
+        f" kg/m^3 ({m.source}); c = {m.damping[2]:.1f} 1/s on 162 vertices, {m.damping[3]:.1f} 1/s on"
+        f" 642, fitted on the {m.fitted_on}'s drop test."
         for m in {ball.material.name: ball.material for ball, _, _ in rows}.values()
     )
     fine_part = (
         "\n\n## The same drops on 642 vertices\n\n" + "\n".join(fine_table(rows, fine))
-        + "\n\n*The damping fitted on 162 vertices, unchanged: how much the fit belongs to the mesh.*"
+        + "\n\n*Each ball on 642 vertices with its material's damping fitted on 162 vertices, then with"
+        " the damping fitted again on 642 (the same rule's test; the volleyball takes the leather's):"
+        " how much the fit belongs to the mesh. Contact and peak force on 642: with the damping fitted"
+        " on 642. Wall: the drop with the damping of 162.*"
         if fine else ""
     )  # fmt: skip
     return f"""# Regulation balls as 3-D shells
 
-`python benchmarks/shell_balls.py` (about 3 minutes; `--fine` adds the 642-vertex drops). Each ball
+`python benchmarks/shell_balls.py` (about 3 minutes; `--fine` adds the 642-vertex fits and drops). Each ball
 of `ballenv.shell.balls` is an icosphere of 162 vertices with the rule's radius, mass and pressure
 (the middle of its ranges); its wall is one of three materials, and each material has one loss
 parameter, the deformation damping `c` (`Scene.damping`), fitted on one ball's drop test to the
@@ -234,10 +267,7 @@ def main(argv=None):
     balls.drop(made["tennis_ball"], drop_height=0.05)  # compiles
     if not args.check:
         fitted = {mat: fit_damping(made[name]) for mat, name in FITTED_ON.items()}
-        print("FITTED_DAMPING = {" + ", ".join(f'"{m}": {c:.1f}' for m, c in fitted.items()) + "}")
-        drift = {m: c for m, c in fitted.items() if abs(c - balls.FITTED_DAMPING[m]) > 0.5}
-        if drift:
-            print(f"the presets' damping differs from the fit: {drift}; paste it into ballenv/shell/balls.py")
+        if not check_fits(fitted, 2):
             return 1
     rows = [(ball, *timed_drop(ball)) for ball in made.values()]
     for ball, res, wall in rows:
@@ -258,7 +288,9 @@ def main(argv=None):
     for name in made:
         ring_ball = ring_balls.BALLS[name]()
         ring_rows[name] = (ring_ball, ring_balls.drop(ring_ball, drop_height=rows_height(rows, name)))
-    fine = {name: timed_drop(make(subdivisions=3)) for name, make in balls.BALLS.items()} if args.fine else {}
+    fine = fine_runs() if args.fine else {}
+    if fine and not args.check and not check_fits(fine["fits"], 3):
+        return 1
     RESULTS.mkdir(exist_ok=True)
     write_text(RESULTS / "shell_balls.md", markdown(rows, pressure, speed, ring_rows, fine))
     return 0

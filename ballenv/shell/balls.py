@@ -2,7 +2,7 @@
 
 A ball is a :class:`Ball`: a :class:`~ballenv.shell.Shell` (its wall and gas, at the origin), the
 wall's :class:`Material` and the drop test of its rule (:class:`DropTest`). :func:`drop` runs a drop
-test; :data:`BALLS` names the presets; :func:`rule_drop` gives a ball's scene for its rule's drop::
+test (its rule's, or from any height, at any pressure); :data:`BALLS` names the presets::
 
     from ballenv.shell.balls import basketball, drop
 
@@ -25,14 +25,18 @@ How a preset is made (SI units):
 * **loss**: one deformation damping ``c`` (1/s, ``Scene.damping``) per material, fitted by
   ``benchmarks/shell_balls.py`` so that one ball of the material (the one whose rule states a drop
   test) rebounds to the middle of its rule's range; every other rebound of that material (other
-  balls, pressures, impact speeds) is a prediction. Results: ``benchmarks/results/shell_balls.md``.
+  balls, pressures, impact speeds) is a prediction. The fit holds for the mesh it was made on (a
+  finer mesh loses less of the impact's energy at the same damping): ``c`` is fitted on 162 and on
+  642 vertices (subdivisions 2 and 3), the meshes a preset can have. Results:
+  ``benchmarks/results/shell_balls.md``.
 
 A drop (:func:`drop`) releases the ball at rest onto a rigid, frictionless floor (the model has no
 ground compliance: a rigid half-space), isothermal gas over 101,325 Pa, no air drag, with the
 numerical settings of :data:`NUMERICS`. The fall is ballistic (the inflated ball falls without
 deforming), so the run starts with the ball's bottom ``START_GAP`` above the floor at the speed of
 its fall from the drop height. The rebound is measured as the rule measures it: the height of the
-ball's lowest (or highest) vertex at the apex of the centre of mass.
+ball's lowest (or highest) vertex at the apex of the centre of mass (the apex located inside its
+step, the vertices' offsets from the centre taken at the record nearest it).
 """
 
 from __future__ import annotations
@@ -61,15 +65,15 @@ NUMERICS: dict[str, Any] = {"rtol": 1e-4, "rho_infinity": 0.9, "integrator": "ge
 
 @dataclass(frozen=True)
 class Material:
-    """A ball's wall: youngs_modulus E (Pa), poisson_ratio nu, density rho (kg/m^3), and damping c
-    (1/s), the scene's deformation damping fitted on the drop test of ``fitted_on`` (a ball's
-    name); source: where E, nu and rho come from."""
+    """A ball's wall: youngs_modulus E (Pa), poisson_ratio nu, density rho (kg/m^3), and damping:
+    the scene's deformation damping c (1/s) for each mesh (subdivisions k -> c) fitted on the drop
+    test of ``fitted_on`` (a ball's name); source: where E, nu and rho come from."""
 
     name: str
     youngs_modulus: float
     poisson_ratio: float
     density: float
-    damping: float
+    damping: dict[int, float]
     fitted_on: str
     source: str
 
@@ -109,6 +113,11 @@ class Ball:
     rule: str
 
     @property
+    def damping(self) -> float:
+        """The deformation damping c (1/s) of its material, fitted on its mesh."""
+        return self.material.damping[self.shell.subdivisions]
+
+    @property
     def mass(self) -> float:
         """Mass (kg): the lumped masses' sum."""
         area = float(triangle_areas(*_rest_mesh(self.shell)).sum())
@@ -136,7 +145,7 @@ class Ball:
         keywords); ``pressure`` (Pa gauge, inflated) pumps the same ball to another pressure."""
         shell = self.shell if pressure is None else self.pumped(pressure)
         shell = dataclasses.replace(shell, position=position, velocity=velocity)
-        c = self.material.damping if damping is None else damping
+        c = self.damping if damping is None else damping
         return Scene(shells=[shell], grounds=grounds, damping=c, **{**NUMERICS, **(numerics or {})})
 
 
@@ -170,6 +179,11 @@ def regulation_shell(
             raise ValueError(
                 f"{name} = {value!r} is out of range: must be a finite number in (0, 1e8) {unit}"
             )
+    if subdivisions not in material.damping:
+        raise ValueError(
+            f"subdivisions = {subdivisions!r} is out of range: must be one of {sorted(material.damping)}"
+            f" (the meshes {material.name}'s damping is fitted on)"
+        )
     unit_mesh = icosphere(subdivisions, 1.0)
     area1 = float(triangle_areas(unit_mesh.vertices, unit_mesh.triangles).sum())  # m^2 per R^2
     a1 = 3.0 * volume(unit_mesh.vertices, unit_mesh.triangles) / area1  # a / R
@@ -304,8 +318,8 @@ FIFA_DROP = DropTest(
 )  # fmt: skip
 ITF = (
     "ITF Rules of Tennis, Appendix I (type 2: diameter 6.54-6.86 cm, mass 56.0-59.4 g; no pressure:"
-    " a pressurised ball holds about 12 psi above the atmosphere, the figure commonly quoted,"
-    " e.g. Brody, Cross and Lindsey, The Physics and Technology of Tennis)"
+    " a pressurised ball holds about 12 psi above the atmosphere, as University of Illinois Physics"
+    " Van's Tennis ball facts states; a maker, Artengo, states about 0.8 bar)"
 )
 ITF_DROP = DropTest(
     2.54, (1.35, 1.47), "bottom", "ITF Rules of Tennis, Appendix I (dropped from 254 cm onto"
@@ -316,8 +330,13 @@ FIVB = (
     " 0.300-0.325 kg/cm^2; no drop test)"
 )
 
-# damping (1/s) fitted by benchmarks/shell_balls.py: the middle of the rule's rebound range
-FITTED_DAMPING = {"basketball carcass": 634.1, "synthetic leather": 472.5, "tennis rubber": 881.4}
+# damping (1/s) fitted by benchmarks/shell_balls.py (the middle of the rule's rebound range), on
+# each mesh: subdivisions 2 (162 vertices) and 3 (642)
+FITTED_DAMPING = {
+    "basketball carcass": {2: 634.1, 3: 749.0},
+    "synthetic leather": {2: 472.5, 3: 578.4},
+    "tennis rubber": {2: 881.4, 3: 994.2},
+}
 
 CARCASS = Material(
     "basketball carcass", 20e6, 0.45, 1100.0, FITTED_DAMPING["basketball carcass"], "basketball",
@@ -331,8 +350,8 @@ LEATHER = Material(
 )  # fmt: skip
 TENNIS_RUBBER = Material(
     "tennis rubber", 5e6, 0.49, 1250.0, FITTED_DAMPING["tennis rubber"], "tennis_ball",
-    "a filled natural rubber of about 70 Shore A (Gent's relation of hardness to modulus), nearly"
-    " incompressible; the density of filled rubber, the felt's mass included",
+    "a filled natural rubber of 65-70 Shore A (4.4-5.5 MPa by Gent's relation of hardness to"
+    " modulus), nearly incompressible; the density of filled rubber, the felt's mass included",
 )  # fmt: skip
 
 

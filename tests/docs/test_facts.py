@@ -150,6 +150,38 @@ FACTS = {
             *results_text("soak_rtol.md", r"Newton's rescue \(`[^`]*`\) took (\d+) steps in (\d+) runs"),
         ],
     ),
+    "3-D balls' fitted damping": (
+        "docs/shell.md",
+        r"the basketball\s+carcass's ([\d.]+) 1/s on FIBA's test, synthetic leather's ([\d.]+) 1/s on FIFA's,"
+        r"\s+the tennis rubber's\s+([\d.]+) 1/s on the ITF's",
+        lambda hooks: [
+            results_cell(hooks, "shell_balls.md", (name,), "c (1/s)")
+            for name in ("basketball", "football", "tennis_ball")
+        ],
+    ),
+    "3-D balls' damping fitted on 642 vertices": (
+        "docs/shell.md",
+        r"fitted again on 642 vertices \(([\d.]+), ([\d.]+) and ([\d.]+) 1/s\)",
+        lambda hooks: [
+            results_cell(
+                hooks, "shell_balls.md", (n,), "c on 642 (1/s)", heading="The same drops on 642 vertices"
+            )
+            for n in ("basketball", "football", "tennis_ball")
+        ],
+    ),
+    "3-D volleyball's predicted drop": (
+        "docs/shell.md",
+        r"damping unchanged: ([\d.]+) m from 2 m\s+\(restitution ([\d.]+);",
+        lambda hooks: [
+            results_cell(hooks, "shell_balls.md", ("volleyball",), "rebound (m)"),
+            results_cell(hooks, "shell_balls.md", ("volleyball",), "restitution"),
+        ],
+    ),
+    "3-D tennis ball's contact time": (
+        "docs/shell.md",
+        r"the tennis ball's\s+([\d.]+) ms is",
+        lambda hooks: results_cell(hooks, "shell_balls.md", ("tennis_ball",), "contact (ms)"),
+    ),
     "env throughput": (
         "README.md",
         r"\| env steps per second, [^|]*\| ([\d,]+) \|",
