@@ -3,7 +3,7 @@ rule's drop test, then what the balls predict, and the 3-D ball beside the ring 
 
     python benchmarks/shell_balls.py          # fits; writes benchmarks/results/shell_balls.md
     python benchmarks/shell_balls.py --check  # runs the presets as they are (no fit)
-    python benchmarks/shell_balls.py --fine   # also the 642-vertex fits and drops (about 10 minutes more)
+    python benchmarks/shell_balls.py --fine   # also the 642-vertex fits and drops (about 6 minutes more)
 
 For each material, the deformation damping ``c`` (1/s) is the root of ``rebound(c) - target``
 (scipy's ``brentq``, to 0.5 1/s: about 0.5 mm of rebound) on the drop test of the ball it is fitted
@@ -203,14 +203,14 @@ def markdown(rows, pressure, speed, ring_rows, fine) -> str:
     )  # fmt: skip
     return f"""# Regulation balls as 3-D shells
 
-`python benchmarks/shell_balls.py` (about 3 minutes; `--fine` adds the 642-vertex fits and drops). Each ball
-of `ballenv.shell.balls` is an icosphere of 162 vertices with the rule's radius, mass and pressure
-(the middle of its ranges); its wall is one of three materials, and each material has one loss
-parameter, the deformation damping `c` (`Scene.damping`), fitted on one ball's drop test to the
-middle of its rule's range. Everything else below is predicted. Rigid frictionless floor (the model
-has no ground compliance), isothermal gas over 101,325 Pa, no air drag; generalized-alpha
-(`rho_inf` = 0.9), adaptive steps, `rtol` = 1e-4. One process on a 2-core machine shared with other
-jobs (wall times vary by up to 2x).
+`python benchmarks/shell_balls.py` (about 3 minutes; `--fine`: the 642-vertex fits and drops, about
+6 minutes more). Each ball of `ballenv.shell.balls` is an icosphere of 162 vertices with the rule's
+radius, mass and pressure (the middle of its ranges); its wall is one of three materials, and each
+material has one loss parameter, the deformation damping `c` (`Scene.damping`), fitted on one
+ball's drop test to the middle of its rule's range. Everything else below is predicted. Rigid
+frictionless floor (the model has no ground compliance), isothermal gas over 101,325 Pa, no air
+drag; generalized-alpha (`rho_inf` = 0.9), adaptive steps, `rtol` = 1e-4. One process on a 2-core
+machine shared with other jobs (wall times vary by up to 2x).
 
 The materials:
 
