@@ -238,7 +238,7 @@ def drop(
     :meth:`Ball.scene`), run past its first apex, measured as its rule measures (module doc)."""
     test = ball.drop_test
     height = drop_height if drop_height is not None else (test.drop_height if test else 2.0)
-    if not (isinstance(height, (int, float)) and START_GAP < height <= 100.0):
+    if isinstance(height, bool) or not (isinstance(height, (int, float)) and START_GAP < height <= 100.0):
         raise ValueError(
             f"drop_height = {height!r} is out of range: must be a number in ({START_GAP}, 100] m"
         )

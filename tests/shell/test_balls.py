@@ -102,9 +102,9 @@ def test_fit_check_on_642_vertices_each_fitted_ball_passes_its_rules_drop_test(n
     assert drop(ball).rebound == pytest.approx(ball.drop_test.target, abs=2e-3)
 
 
-def test_the_rebound_is_the_lowest_vertex_at_the_apex(drops):
-    """The bottom at the apex is the centre of mass's apex minus the inflated ball's centre-to-pole
-    distance, up to the skin's ringing (a few mm)."""
+def test_the_rebound_is_the_bottom_at_the_apex_up_to_the_skins_ringing(drops):
+    """The lowest vertex at the apex is the centre of mass's apex minus the inflated ball's
+    centre-to-pole distance, up to the skin's ringing (a few mm)."""
     ball, result = BALLS["football"](), drops["football"]
     _, z_apex = result.trajectory.apexes()[0]
     assert result.rebound == pytest.approx(z_apex - ball.radius, abs=5e-3)
@@ -125,7 +125,8 @@ def test_a_drop_started_near_the_floor_at_the_falls_speed_is_a_release_at_rest()
 
 def test_prediction_the_volleyball_of_the_footballs_leather_bounces_like_a_softer_football(drops):
     """The volleyball takes the football's material and damping unchanged (no rule drop test):
-    at 38 % of the football's pressure its contact is longer and its restitution lower."""
+    at 38 % of the football's pressure its contact is longer and its restitution lower, yet above
+    0.6 (a rebound above a third of the drop)."""
     volley, foot = drops["volleyball"], drops["football"]
     assert volley.contact_time > foot.contact_time
     assert 0.6 < volley.restitution < foot.restitution
