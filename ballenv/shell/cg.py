@@ -43,7 +43,8 @@ def make_operator(pattern: blocks.BlockPattern, rank: int) -> Operator:
     z = np.zeros
     values = z((len(pattern.cols), 3, 3))
     blocks3 = (n_vertices, 3, 3)
-    return Operator(pattern, values, z(blocks3), z((rank, n_vertices, 3)), z(rank), z(blocks3), z(values.shape))
+    vectors = z((rank, n_vertices, 3))
+    return Operator(pattern, values, z(blocks3), vectors, z(rank), z(blocks3), z(values.shape))
 
 
 @kernel

@@ -75,10 +75,11 @@ def _envelope_solve(problem, owners, c_x, s, vertex_blocks, rhs, out, z, zero):
 def solve(problem, owners, op, coefficients, contact_blocks, mass_term, basis, rhs, out, work, assemble):
     """``out = A^-1 rhs`` (module doc) with the triangles' matrices (unscaled) and ``dV/dx`` in the
     workspace of ``problem`` (equilibrium.Problem) and the hinges' part in ``op.hinge_values``
-    (blocks.assemble_hinges), assembled into ``op`` if ``assemble`` (else those assembled before), ``coefficients = (c_x, s, d, CG's rtol)``, the contact's vertex blocks
-    (V, 3, 3), the diagonal ``mass_term`` (V,) per vertex and the rank-6 ``basis`` (6, V, 3) or
-    (0, V, 3). Returns the CG iterations, -1 when the envelope solved it (the workspace's element
-    matrices are then changed), -2 when that matrix was not positive definite."""
+    (blocks.assemble_hinges), assembled into ``op`` if ``assemble`` (else those assembled before),
+    ``coefficients = (c_x, s, d, CG's rtol)``, the contact's vertex blocks (V, 3, 3), the diagonal
+    ``mass_term`` (V,) per vertex and the rank-6 ``basis`` (6, V, 3) or (0, V, 3). Returns the CG
+    iterations, -1 when the envelope solved it (the workspace's element matrices are then changed),
+    -2 when that matrix was not positive definite."""
     ws = problem.ws
     c_x, s, d, rtol = coefficients
     if assemble:
