@@ -2,7 +2,8 @@
 (``Shell()``: R = 0.12 m, E = 5 MPa, nu = 0.45, h = 3 mm, rho = 1100 kg/m^3, p = 55 kPa, isothermal
 gas) on a flat ground with friction 0.5, ``Scene`` defaults otherwise (generalized-alpha, rho_inf =
 0.9, adaptive steps with rtol = 1e-4, no damping), on icospheres of 162 and 642 vertices; then the
-same at rtol = 3e-4 (what the first apex's accuracy allows, measured here).
+same ball with the fidelity preset of its mesh (``ballenv.shell.presets``: "fast" on 162 vertices,
+"balanced" on 642).
 
     taskset -c 0 python benchmarks/shell_drop.py                     # writes benchmarks/results/shell_drop.md
     taskset -c 0 python benchmarks/shell_drop.py --baseline DIR      # also runs the code checked out in DIR
@@ -37,13 +38,15 @@ import tempfile  # noqa: E402
 
 from ballenv.files import write_text  # noqa: E402
 from ballenv.shell import Ground, Scene, Shell, simulate  # noqa: E402
+from ballenv.shell.presets import with_fidelity  # noqa: E402
 
 RESULTS = pathlib.Path(__file__).parent / "results"
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 DROP = 0.5  # m: the centre's start height
 BOUNCES = 3
 TARGETS = {2: 10.0, 3: 1.0}  # subdivisions -> the real-time factor asked for
-RTOLS = (1e-4, 3e-4)  # the Scene default, and the largest whose first apex is within 1 %
+DEFAULT_RTOL = 1e-4  # the Scene default
+PRESETS = {2: "fast", 3: "balanced"}  # the preset of each mesh
 REFERENCE_RTOL = 1e-6
 FIRST_APEX_END = 0.65  # s: after the first apex (at about 0.56 s)
 SCALING_END = 0.32  # s
@@ -69,16 +72,19 @@ print(time.perf_counter() - t0)
 """
 
 
-def scene_of(subdivisions: int, rtol: float, height: float = DROP, speed: float = 0.0) -> Scene:
+def scene_of(
+    subdivisions: int, rtol: float, height: float = DROP, speed: float = 0.0, preset: str | None = None
+) -> Scene:
     """The benchmark's drop on the ``subdivisions`` icosphere at ``rtol`` from ``height`` (m) at
-    ``speed`` (m/s) downwards."""
+    ``speed`` (m/s) downwards, or with the fidelity ``preset`` (its mesh and step control)."""
     ball = Shell(subdivisions=subdivisions, position=(0.0, 0.0, height), velocity=(0.0, 0.0, -speed))
-    return Scene(shells=[ball], grounds=[Ground(friction=0.5)], rtol=rtol)
+    scene = Scene(shells=[ball], grounds=[Ground(friction=0.5)], rtol=rtol)
+    return with_fidelity(scene, preset) if preset else scene
 
 
 def warm(subdivisions: int, rtol: float) -> None:
     """Compiles what a drop runs, contact included (a short run touching the ground)."""
-    simulate(scene_of(subdivisions, rtol, height=0.128, speed=1.0), t_end=0.005)
+    simulate(scene_of(subdivisions, rtol, height=0.135, speed=1.0), t_end=0.005)
 
 
 def baseline(directory: str, subdivisions: int, rtol: float, t_end: float) -> dict:
@@ -96,9 +102,11 @@ def reference_apex(subdivisions: int) -> float:
     return float(simulate(scene_of(subdivisions, REFERENCE_RTOL), t_end=FIRST_APEX_END).apexes()[0, 1])
 
 
-def run(subdivisions: int, rtol: float, reference: float, old: str | None) -> dict:
-    """The drop of the ``subdivisions`` ball at ``rtol`` up to the touchdown after its third apex."""
-    scene = scene_of(subdivisions, rtol)
+def run(subdivisions: int, preset: str | None, reference: float, old: str | None) -> dict:
+    """The drop of the ``subdivisions`` ball (``Scene`` defaults, or the fidelity ``preset``) up to
+    the touchdown after its third apex."""
+    rtol = DEFAULT_RTOL
+    scene = scene_of(subdivisions, rtol, preset=preset)
     warm(subdivisions, rtol)
     t_end = 2.4
     before = baseline(old, subdivisions, rtol, t_end) if old else None
@@ -112,7 +120,7 @@ def run(subdivisions: int, rtol: float, reference: float, old: str | None) -> di
     wall = s.wall_time * share  # the stepping's time up to the last touchdown (steps pro rata)
     return {
         "vertices": scene.shells[0].n_vertices,
-        "rtol": rtol,
+        "settings": f"preset {preset}" if preset else f"defaults (rtol {rtol:g})",
         "simulated": simulated,
         "wall": wall,
         "real_time": simulated / wall,
@@ -133,8 +141,8 @@ def run(subdivisions: int, rtol: float, reference: float, old: str | None) -> di
 
 def scaling(subdivisions: int) -> dict:
     """Cost per step and per Newton iteration (ms) of the first ``SCALING_END`` s at rtol 1e-4."""
-    scene = scene_of(subdivisions, RTOLS[0])
-    warm(subdivisions, RTOLS[0])
+    scene = scene_of(subdivisions, DEFAULT_RTOL)
+    warm(subdivisions, DEFAULT_RTOL)
     s = simulate(scene, t_end=SCALING_END).stats
     return {
         "vertices": scene.shells[0].n_vertices,
@@ -157,15 +165,15 @@ def cold_compile_seconds() -> float:
 
 def table(rows: list[dict]) -> str:
     head = (
-        "| vertices | rtol | simulated (s) | wall (s) | wall per simulated s | x real time | target "
+        "| vertices | settings | simulated (s) | wall (s) | wall per simulated s | x real time | target "
         "| ratio to target | first apex (m) | first-apex error | apexes (m) | touchdowns | steps "
         "| rejected | Newton iterations | per step | CG iterations | envelope solves "
         "| wall per step (ms) | old wall per step (ms) | speed-up |\n"
-        "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:"
+        "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:"
         "|---:|---:|---:|\n"
     )
     body = "".join(
-        f"| {r['vertices']} | {r['rtol']:g} | {r['simulated']:.3f} | {r['wall']:.1f} "
+        f"| {r['vertices']} | {r['settings']} | {r['simulated']:.3f} | {r['wall']:.1f} "
         f"| {r['wall'] / r['simulated']:.1f} "
         f"| {r['real_time']:.3f} | {r['target']:g} | {r['real_time'] / r['target']:.4f} | {r['apex']:.4f} "
         f"| {100 * r['apex_error']:+.2f} % | {r['apexes']} | {r['touchdowns']} | {r['steps']} "
@@ -198,7 +206,7 @@ def main() -> None:
     rows = []
     for k in (2, 3):
         reference = reference_apex(k)
-        rows += [run(k, rtol, reference, args.baseline if rtol == RTOLS[0] else None) for rtol in RTOLS]
+        rows += [run(k, None, reference, args.baseline), run(k, PRESETS[k], reference, None)]
     scale = [scaling(k) for k in (2, 3, 4)]
     name = pathlib.Path(__file__).relative_to(pathlib.Path(__file__).parents[1])
     text = (
@@ -210,7 +218,7 @@ def main() -> None:
         f"First-apex error: against a run at rtol = {REFERENCE_RTOL:g} of the same mesh. "
         "Old wall per step and speed-up: the code given by `--baseline`, run just before in the same "
         "process's minutes, over the whole run to 2.4 s (- where not run).\n\n"
-        f"Cost against the vertex count (the first {SCALING_END:g} s, rtol = {RTOLS[0]:g}):\n\n"
+        f"Cost against the vertex count (the first {SCALING_END:g} s, rtol = {DEFAULT_RTOL:g}):\n\n"
         + scaling_table(scale)
         + "\nThe first drop in a new process with an empty numba cache (compiling the shell): "
         f"{compile_s:.0f} s.\n"

@@ -179,15 +179,45 @@ def hinge_angle_derivatives(x, hinge, k, scratch, dtheta, htheta, with_hessian):
 
 @kernel
 def bending_gradient(x, hinge, theta0, weight, kb, scratch, grad):
-    """Adds the bending energy's gradient (N) to ``grad`` (V, 3)."""
-    g = scratch.g
+    """Adds the bending energy's gradient (N) to ``grad`` (V, 3), from the angle's closed-form
+    gradient (module doc): ``dtheta/db = -|a| n1 / |n1|^2``, ``dtheta/dc = -|a| n2 / |n2|^2``,
+    ``dtheta/da = -((a.b) dtheta/db + (a.c) dtheta/dc) / (a.a)`` (the angle does not change when
+    the hinge turns about its edge), ``dtheta/dx0 = -(dtheta/da + dtheta/db + dtheta/dc)``."""
+    abc = scratch.abc
     for k in range(hinge.shape[0]):
-        theta = hinge_angle_derivatives(x, hinge, k, scratch, g, scratch.hx, False)
+        _edge_vectors(x, hinge, k, abc)
+        a0, a1, a2 = abc[0, 0], abc[0, 1], abc[0, 2]
+        b0, b1, b2 = abc[1, 0], abc[1, 1], abc[1, 2]
+        c0, c1, c2 = abc[2, 0], abc[2, 1], abc[2, 2]
+        n10, n11, n12 = a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0  # a x b
+        n20, n21, n22 = c1 * a2 - c2 * a1, c2 * a0 - c0 * a2, c0 * a1 - c1 * a0  # c x a
+        aa = a0 * a0 + a1 * a1 + a2 * a2
+        ab = a0 * b0 + a1 * b1 + a2 * b2
+        ac = a0 * c0 + a1 * c1 + a2 * c2
+        la = np.sqrt(aa)
+        big_x = n10 * n20 + n11 * n21 + n12 * n22
+        big_y = -la * (n10 * c0 + n11 * c1 + n12 * c2)  # -|a| det(a, b, c)
+        theta = np.arctan2(big_y, big_x)
         s = 2.0 * kb * weight[k] * (theta - theta0[k])
-        for c in range(3):
-            grad[hinge[k, 0], c] -= s * (g[c] + g[3 + c] + g[6 + c])
-            for m in range(3):
-                grad[hinge[k, m + 1], c] += s * g[3 * m + c]
+        s1 = -s * la / (n10 * n10 + n11 * n11 + n12 * n12)
+        s2 = -s * la / (n20 * n20 + n21 * n21 + n22 * n22)
+        gb0, gb1, gb2 = s1 * n10, s1 * n11, s1 * n12
+        gc0, gc1, gc2 = s2 * n20, s2 * n21, s2 * n22
+        wb, wc = -ab / aa, -ac / aa
+        ga0, ga1, ga2 = wb * gb0 + wc * gc0, wb * gb1 + wc * gc1, wb * gb2 + wc * gc2
+        i, j, m, n = hinge[k, 0], hinge[k, 1], hinge[k, 2], hinge[k, 3]
+        grad[i, 0] -= ga0 + gb0 + gc0
+        grad[i, 1] -= ga1 + gb1 + gc1
+        grad[i, 2] -= ga2 + gb2 + gc2
+        grad[j, 0] += ga0
+        grad[j, 1] += ga1
+        grad[j, 2] += ga2
+        grad[m, 0] += gb0
+        grad[m, 1] += gb1
+        grad[m, 2] += gb2
+        grad[n, 0] += gc0
+        grad[n, 1] += gc1
+        grad[n, 2] += gc2
 
 
 @kernel

@@ -67,6 +67,24 @@ def assemble(pattern, tri_mats, hinge_mats, scale, values):
     _scatter(pattern.hinge_slots, hinge_mats, scale, values)
 
 
+@kernel
+def assemble_hinges(pattern, hinge_mats, out):
+    """``out`` (B, 3, 3) = the hinges' matrices alone (kept while they are, :func:`assemble_kept`)."""
+    out[:] = 0.0
+    _scatter(pattern.hinge_slots, hinge_mats, 1.0, out)
+
+
+@kernel
+def assemble_kept(pattern, tri_mats, hinge_values, scale, values):
+    """``values`` (B, 3, 3) = ``scale`` (triangles' matrices + ``hinge_values``, the hinges' part
+    assembled by :func:`assemble_hinges`)."""
+    for k in range(values.shape[0]):
+        for c in range(3):
+            for d in range(3):
+                values[k, c, d] = scale * hinge_values[k, c, d]
+    _scatter(pattern.tri_slots, tri_mats, scale, values)
+
+
 @kernel(fastmath=True)
 def multiply(pattern, values, x, y):
     """``y = A x`` (V, 3)."""

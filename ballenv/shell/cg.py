@@ -34,6 +34,7 @@ class Operator(NamedTuple):
     vectors: NDArray[np.float64]  # (K, V, 3)
     weights: NDArray[np.float64]  # (K,)
     inverses: NDArray[np.float64]  # (V, 3, 3) 1/(N/m): the preconditioner (block_inverses)
+    hinge_values: NDArray[np.float64]  # (B, 3, 3) N/m: the hinges' part of ``values``, unscaled
 
 
 def make_operator(pattern: blocks.BlockPattern, rank: int) -> Operator:
@@ -42,7 +43,8 @@ def make_operator(pattern: blocks.BlockPattern, rank: int) -> Operator:
     z = np.zeros
     values = z((len(pattern.cols), 3, 3))
     blocks3 = (n_vertices, 3, 3)
-    return Operator(pattern, values, z(blocks3), z((rank, n_vertices, 3)), z(rank), z(blocks3))
+    vectors = z((rank, n_vertices, 3))
+    return Operator(pattern, values, z(blocks3), vectors, z(rank), z(blocks3), z(values.shape))
 
 
 @kernel

@@ -230,7 +230,20 @@ def step_kernel(method, st, x0, v0, a0, h):
         for c in range(3):
             wk.force[i, c] = -wk.force[i, c]
     increment.kinematics(method, sp, wk.x, wk.a1, wk.v1, wk.va)
+    wk.energy[0] = _energy(st, wk.x, wk.v1)
     return 0, newton_total, cg_total, envelope_total
+
+
+@kernel
+def _energy(st, x, v):
+    """Kinetic + stretching + bending + gas + gravity + barrier energy (J) of ``(x, v)``."""
+    p = st.problem
+    kinetic = 0.0
+    for i in range(x.shape[0]):
+        for c in range(3):
+            kinetic += 0.5 * p.model.mass[i] * v[i, c] * v[i, c]
+    barrier = ground.barrier_energy(x, st.normals, st.heights, st.dhat, st.kappa)
+    return kinetic + potential.energy(p.model, p.ws, x, p.loads) + barrier
 
 
 class StepResult(NamedTuple):
@@ -240,6 +253,7 @@ class StepResult(NamedTuple):
     v: F64
     a: F64
     contact_force: F64  # (V, 3) N: the barriers' and friction's force at x1
+    energy: float  # J: total_energy at the end
     iterations: int
     cg_iterations: int
     envelope_solves: int
@@ -256,8 +270,9 @@ def step(method: Integrator, st: ShellStep, x0: F64, v0: F64, a0: F64, h: float)
         raise StepFailure(f"the step of {h:.3e} s failed: {FAILURES[status]}")
     wk = st.work
     return StepResult(
-        wk.x.copy(), wk.v1.copy(), wk.a1.copy(), wk.force.copy(), iterations, cg_iterations, envelope_solves
-    )
+        wk.x.copy(), wk.v1.copy(), wk.a1.copy(), wk.force.copy(), float(wk.energy[0]),
+        iterations, cg_iterations, envelope_solves,
+    )  # fmt: skip
 
 
 def start(method: Integrator, st: ShellStep, x0: F64, v0: F64, a0: F64, h: float) -> Start:
@@ -306,7 +321,4 @@ def initial_acceleration(st: ShellStep, x: F64, v: F64) -> F64:
 
 def total_energy(st: ShellStep, x: F64, v: F64) -> float:
     """Kinetic + stretching + bending + gas + gravity + barrier energy (J)."""
-    p = st.problem
-    kinetic = 0.5 * float(np.sum(p.model.mass[:, None] * v * v))
-    barrier = ground.barrier_energy(x, st.normals, st.heights, st.dhat, st.kappa)
-    return kinetic + potential.energy(p.model, p.ws, x, p.loads) + barrier
+    return float(_energy(st, np.ascontiguousarray(x), np.ascontiguousarray(v)))

@@ -22,6 +22,7 @@ from ..physics.base.jit import kernel
 from ..physics.step import integrator
 from . import damping, friction, gas, ground, potential, stepsolve
 from .bending import bending_hessians
+from .blocks import assemble_hinges
 
 BENDING_AGE = 8  # fresh assemblies that keep the hinges' matrices
 
@@ -137,6 +138,7 @@ def direction(st, sp, x1, grad, blocks, wk, dx, fresh, rtol):
         if age[0] < 0 or age[0] >= BENDING_AGE:
             m = p.model
             bending_hessians(wk.xa, m.hinges, m.theta0, m.weight, m.kb, p.ws.scratch, p.ws.hinge_hess)
+            assemble_hinges(st.op.pattern, p.ws.hinge_hess, st.op.hinge_values)
             age[0] = 0
         age[0] += 1
         s = c_x * potential.triangle_hessian(p.model, p.ws, wk.xa)

@@ -97,25 +97,33 @@ def membrane_gradient(x, tri, beta, area, lam, mu, h, f, grad):
 
 @kernel
 def membrane_hessians(x, tri, beta, area, lam, mu, h, f, out):
-    """Each triangle's Hessian (N/m) of its stretching energy into ``out`` (T, 9, 9) (overwritten)."""
+    """Each triangle's Hessian (N/m) of its stretching energy into ``out`` (T, 9, 9) (overwritten).
+
+    With ``P_ij = f_i f_j^T`` the module doc's block of vertices ``(a, b)`` is
+    ``A h [c00 P00 + c11 P11 + c01 P01 + c10 P10 + (beta_a . S beta_b) I]``,
+    ``c00 = (lam + 2 mu) a1 b1 + mu a2 b2``, ``c11 = (lam + 2 mu) a2 b2 + mu a1 b1``,
+    ``c01 = lam a1 b2 + mu a2 b1``, ``c10 = lam a2 b1 + mu a1 b2`` (``a_i``, ``b_i`` the
+    components of ``beta_a``, ``beta_b``); the block of ``(b, a)`` is its transpose."""
+    stiff = lam + 2.0 * mu
     for t in range(tri.shape[0]):
         _deformation(x, tri, beta, t, f)
         _, _, _, s11, s12, s22 = _strain_stress(f, lam, mu)
         ah = area[t] * h
         for a in range(3):
             a1, a2 = beta[t, a, 0], beta[t, a, 1]
-            for b in range(3):
+            for b in range(a, 3):
                 b1, b2 = beta[t, b, 0], beta[t, b, 1]
                 geometric = a1 * (s11 * b1 + s12 * b2) + a2 * (s12 * b1 + s22 * b2)
+                c00 = stiff * a1 * b1 + mu * a2 * b2
+                c11 = stiff * a2 * b2 + mu * a1 * b1
+                c01 = lam * a1 * b2 + mu * a2 * b1
+                c10 = lam * a2 * b1 + mu * a1 * b2
                 for c in range(3):
-                    fa_c = f[0, c] * a1 + f[1, c] * a2
-                    g11a, g22a = a1 * f[0, c], a2 * f[1, c]
-                    g12a = 0.5 * (a1 * f[1, c] + a2 * f[0, c])
+                    f0c, f1c = f[0, c], f[1, c]
                     for d in range(3):
-                        fb_d = f[0, d] * b1 + f[1, d] * b2
-                        g11b, g22b = b1 * f[0, d], b2 * f[1, d]
-                        g12b = 0.5 * (b1 * f[1, d] + b2 * f[0, d])
-                        v = lam * fa_c * fb_d + 2.0 * mu * (g11a * g11b + 2.0 * g12a * g12b + g22a * g22b)
+                        f0d, f1d = f[0, d], f[1, d]
+                        v = c00 * f0c * f0d + c11 * f1c * f1d + c01 * f0c * f1d + c10 * f1c * f0d
                         if c == d:
                             v += geometric
                         out[t, 3 * a + c, 3 * b + d] = ah * v
+                        out[t, 3 * b + d, 3 * a + c] = ah * v

@@ -13,6 +13,9 @@ shell's vertices of at most ``rtol R``: a larger one rejects the step, and the n
 steps are ``dt``, and a halved step doubles back after each accepted step. Records are every
 accepted step, or, with ``output_dt``, at its multiples, interpolated inside the steps (cubic
 Hermite positions and their derivative; contact forces linearly), which never changes the steps.
+Each shell's energy is held to its value at the start (budget.py): an accepted step's small excess
+is taken from its deformation's (or spin's) kinetic energy, a larger one rejects the step. Every
+vertex must start above every ground (``ValueError`` otherwise).
 """
 
 import time
@@ -22,7 +25,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..physics.step import integrator
-from . import events, ground, implicit, stepdata
+from . import budget, events, ground, implicit, stepdata
 from .equilibrium import equilibrium
 from .gas import gauge_pressure, volume
 from .model import build_model
@@ -110,6 +113,16 @@ def initial_states(scene: Scene, x0: ArrayLike | None, v0: ArrayLike | None) -> 
         vs[:] = np.asarray(v0, dtype=np.float64).reshape(shape)
     if not (np.all(np.isfinite(xs)) and np.all(np.isfinite(vs))):
         raise ValueError(f"x0 and v0 must be finite arrays of shape {shape} (m, m/s)")
+    for k, shell in enumerate(scene.shells):
+        for g, gr in enumerate(scene.grounds):
+            gap = float((xs[k] @ np.array(gr.normal)).min()) - gr.height
+            if gap <= 0.0:
+                name = "x0" if x0 is not None else f"Scene.shells[{k}].position"
+                value = "given" if x0 is not None else shell.position
+                raise ValueError(
+                    f"{name} = {value} is out of range: shell {k} starts {-gap:.4g} m through "
+                    f"grounds[{g}]; every vertex must start above every ground"
+                )
     return xs, vs
 
 
@@ -202,6 +215,18 @@ class Run:
         self.recorder, self.stats = Recorder(output_dt, self.steps), SimulationStats()
         self.events: list[tuple[float, int, str, float]] = []
         self.recorder.add(0.0, self.x, self.v, self.force)
+        self.budget = budget.energies(self.steps, self.x, self.v)
+
+    def within_budget(self, results: list[implicit.StepResult]) -> bool:
+        """Holds each shell's step end to its energy budget (budget.py), scaling the results'
+        velocities in place; False if the step must be rejected."""
+        for k, r in enumerate(results):
+            held = r.energy <= self.budget[k] or budget.hold(
+                self.steps[k], r.x, r.v, r.energy, self.budget[k]
+            )
+            if not held:
+                return False
+        return True
 
     def accept(self, t: float, h: float, results: list[implicit.StepResult]) -> None:
         """Takes the step ``[t, t + h]``: its events, records and work."""
@@ -255,6 +280,9 @@ def simulate(
         ratio = error_ratio(scene, method, run.steps, run.a, a1, trial) if scene.adaptive else 0.0
         if ratio > 1.0:
             h = run.reject(t, trial * max(SHRINK, 0.9 * ratio**-q), "the error control shrank the step")
+            continue
+        if not run.within_budget(results):
+            h = run.reject(t, 0.5 * trial, "the step gained energy; halved")
             continue
         run.accept(t, trial, results)
         t += trial

@@ -50,6 +50,7 @@ class Work(NamedTuple):
     mass_term: F64  # (V,) N/m: the Newton matrix's diagonal per vertex
     bending_age: NDArray[np.int64]  # (1,): fresh assemblies since the hinges' matrices, -1: none
     u3: F64  # (3,)
+    energy: F64  # (1,) J: the total energy at the step's end (implicit.total_energy)
 
 
 class ShellStep(NamedTuple):
@@ -85,7 +86,7 @@ def make_work(n_vertices: int, n_grounds: int) -> Work:
     return Work(
         z(v3), z(v3), z(v3), z(v3), z(v3), z(v3),
         z(v3), z(b3), z(v3), z(b3), z(v3), z(v3), z(v3), z(v3), z((n_vertices, n_grounds)),
-        z((4,) + v3), z(n_vertices), np.full(1, -1, dtype=np.int64), z(3),
+        z((4,) + v3), z(n_vertices), np.full(1, -1, dtype=np.int64), z(3), z(1),
     )  # fmt: skip
 
 

@@ -73,16 +73,17 @@ def _envelope_solve(problem, owners, c_x, s, vertex_blocks, rhs, out, z, zero):
 
 @kernel
 def solve(problem, owners, op, coefficients, contact_blocks, mass_term, basis, rhs, out, work, assemble):
-    """``out = A^-1 rhs`` (module doc) with the element matrices (unscaled) and ``dV/dx`` in the
-    workspace of ``problem`` (equilibrium.Problem), assembled into ``op`` if ``assemble`` (else
-    those assembled before), ``coefficients = (c_x, s, d, CG's rtol)``, the contact's vertex blocks
-    (V, 3, 3), the diagonal ``mass_term`` (V,) per vertex and the rank-6 ``basis`` (6, V, 3) or
-    (0, V, 3). Returns the CG iterations, -1 when the envelope solved it (the workspace's element
-    matrices are then changed), -2 when that matrix was not positive definite."""
+    """``out = A^-1 rhs`` (module doc) with the triangles' matrices (unscaled) and ``dV/dx`` in the
+    workspace of ``problem`` (equilibrium.Problem) and the hinges' part in ``op.hinge_values``
+    (blocks.assemble_hinges), assembled into ``op`` if ``assemble`` (else those assembled before),
+    ``coefficients = (c_x, s, d, CG's rtol)``, the contact's vertex blocks (V, 3, 3), the diagonal
+    ``mass_term`` (V,) per vertex and the rank-6 ``basis`` (6, V, 3) or (0, V, 3). Returns the CG
+    iterations, -1 when the envelope solved it (the workspace's element matrices are then changed),
+    -2 when that matrix was not positive definite."""
     ws = problem.ws
     c_x, s, d, rtol = coefficients
     if assemble:
-        blocks.assemble(op.pattern, ws.tri_hess, ws.hinge_hess, c_x, op.values)
+        blocks.assemble_kept(op.pattern, ws.tri_hess, op.hinge_values, c_x, op.values)
     for v in range(rhs.shape[0]):
         for a in range(3):
             for b in range(3):
