@@ -1,18 +1,19 @@
-"""``simulate(scene, t_end)``: shells under their gas, gravity, damping, grounds and friction,
-advanced by implicit steps (implicit.py), recorded in a :class:`Trajectory` (SI units).
+"""``simulate(scene, t_end)``: shells under their gas, gravity, damping, grounds and friction, advanced
+by implicit steps (implicit.py), recorded in a :class:`Trajectory` (SI units).
 
 Each shell starts from its inflated equilibrium (equilibrium.py) centred at its ``position``, or
-from ``x0``, with the velocity ``velocity + angular_velocity x (x - centre)`` or ``v0``. All
-shells take the same steps. Step control: a step whose Newton iteration fails for any shell is
-rejected (never accepted) and retried with half the step; below ``dt_min`` ``simulate`` raises
-:class:`SimulationError`. With ``adaptive``, the local error estimate of the ring's integrators
-(``ballenv.physics.step.integrator``), ``e_i = c h^2 (a1_i - w a0_i)`` (m; generalized-alpha
-``c = beta - 1/6``, ``w = 1``; backward Euler ``c = 1/2``, ``w = 0``), must have an RMS over each
-shell's vertices of at most ``rtol R``: a larger one rejects the step, and the next step is
-``h min(1.25, max(0.2, 0.9 (rtol R / e)^q))`` (``q`` 1/3 or 1/2), at most ``dt``. Without it,
-steps are ``dt``, and a halved step doubles back after each accepted step. Records are every
-accepted step, or, with ``output_dt``, at its multiples, interpolated inside the steps (cubic
-Hermite positions and their derivative; contact forces linearly), which never changes the steps.
+from ``x0``, with the velocity ``velocity + angular_velocity x (x - centre)`` or ``v0``. All shells
+take the same steps; shells that may touch take them jointly (groups.py, joint.py). Step control: a
+step whose Newton iteration fails for any shell is rejected (never accepted) and retried with half
+the step; below ``dt_min`` ``simulate`` raises :class:`SimulationError`. With ``adaptive``, the
+local error estimate of the ring's integrators (``ballenv.physics.step.integrator``), ``e_i = c h^2
+(a1_i - w a0_i)`` (m; generalized-alpha ``c = beta - 1/6``, ``w = 1``; backward Euler ``c = 1/2``,
+``w = 0``), must have an RMS over each shell's vertices of at most ``rtol R``: a larger one rejects
+the step, and the next step is ``h min(1.25, max(0.2, 0.9 (rtol R / e)^q))`` (``q`` 1/3 or 1/2), at
+most ``dt``. Without it, steps are ``dt``, and a halved step doubles back after each accepted step.
+Records are every accepted step, or, with ``output_dt``, at its multiples, interpolated inside the
+steps (cubic Hermite positions and their derivative; contact forces linearly), which never changes
+the steps.
 """
 
 import time
@@ -22,7 +23,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..physics.step import integrator
-from . import events, ground, implicit, stepdata
+from . import events, ground, groups, implicit, stepdata
 from .equilibrium import equilibrium
 from .gas import gauge_pressure, volume
 from .model import build_model
@@ -39,7 +40,8 @@ class SimulationError(RuntimeError):
 @dataclass
 class SimulationStats:
     """steps: accepted; rejections; newton_iterations, cg_iterations and envelope_solves (the CG
-    fallback) summed over shells and accepted steps; wall_time (s) of the stepping."""
+    fallback) summed over shells (a joint step of shells in contact counts once) and accepted steps;
+    wall_time (s) of the stepping."""
 
     steps: int = 0
     rejections: int = 0
@@ -52,7 +54,8 @@ class SimulationStats:
 @dataclass
 class Trajectory:
     """t (T,) s; x, v (T, shells, V, 3) m, m/s; contact_force (T, shells, V, 3) N, the grounds'
-    barrier and friction force; pressure (T, shells) Pa gauge; events: ``(t s, shell, kind,
+    barrier and friction force plus the contact barrier's between shells and within one (contact.py);
+    pressure (T, shells) Pa gauge; events: ``(t s, shell, kind,
     centre-of-mass height m)`` with kind "apex", "touchdown" or "liftoff"; stats."""
 
     t: F64
@@ -167,9 +170,16 @@ def error_ratio(
 
 
 def try_step(
-    method: implicit.Integrator, steps: list[stepdata.ShellStep], state: tuple[F64, F64, F64], h: float
+    method: implicit.Integrator,
+    steps: list[stepdata.ShellStep],
+    state: tuple[F64, F64, F64],
+    h: float,
+    contacts: groups.Contacts | None = None,
 ) -> list[implicit.StepResult]:
-    """Every shell's step of ``h`` (s), or :class:`implicit.StepFailure`."""
+    """Every shell's step of ``h`` (s), or :class:`implicit.StepFailure`; with ``contacts``, shells
+    that may touch step jointly (groups.py)."""
+    if contacts is not None:
+        return contacts.step(method, state, h)
     x, v, a = state
     return [implicit.step(method, st, x[k], v[k], a[k], h) for k, st in enumerate(steps)]
 
@@ -192,6 +202,9 @@ class Run:
     def __init__(self, scene: Scene, x0: ArrayLike | None, v0: ArrayLike | None, output_dt: float | None):
         self.scene = scene
         self.method, self.steps = build(scene)
+        touching = len(self.steps) > 1 or scene.self_contact
+        dhat = scene.contact_distance
+        self.contacts = groups.Contacts(self.steps, dhat, scene.self_contact) if touching else None
         self.x, self.v = initial_states(scene, x0, v0)
         self.a = np.array(
             [implicit.initial_acceleration(st, self.x[k], self.v[k]) for k, st in enumerate(self.steps)]
@@ -247,7 +260,7 @@ def simulate(
     while t < t_end * (1.0 - 1e-12):
         trial = min(h, t_end - t)
         try:
-            results = try_step(method, run.steps, (run.x, run.v, run.a), trial)
+            results = try_step(method, run.steps, (run.x, run.v, run.a), trial, run.contacts)
         except implicit.StepFailure:
             h = run.reject(t, 0.5 * trial, "the step was halved")
             continue
