@@ -75,9 +75,10 @@ class Contacts:
     def _joint(self, group: tuple[int, ...], room: int) -> Joint:
         kept = self.joints.get(group)
         if kept is None or kept[1] < room:
-            tri = self.steps[group[0]].problem.model.triangles
-            n = len(self.steps[group[0]].problem.model.rest)
-            jt = make_joint(tri, n, self.kappa[list(group)], self.dhat, self.self_contact, room)
+            model = self.steps[group[0]].problem.model
+            rest = np.array([self.steps[k].problem.model.rest for k in group])
+            mesh = (model.triangles, model.edges)
+            jt = make_joint(mesh, rest, self.kappa[list(group)], self.dhat, self.self_contact, room)
             kept = self.joints[group] = (jt, room)
         return kept[0]
 

@@ -1,19 +1,19 @@
-"""One implicit step of a group of shells that may touch: one Newton iteration over all their
-vertices, minimising the sum of their incremental potentials and the contact barrier between them
-(and within each, with self-contact)::
+"""One implicit step of a group of shells that may touch: one Newton iteration over all their vertices,
+minimising the sum of their incremental potentials and the contact barrier between them (and within
+each, with self-contact)::
 
     Phi(x1) = sum_k Phi_k(x1_k) + B_c(x1)                                                   (J)
 
 ``Phi_k`` each shell's incremental potential (increment.py: inertia, skin, gas, gravity, grounds,
-friction, damping; the gas's rank-one and the damping's rank-6 terms stay per shell) and ``B_c``
-the point-triangle barrier of contact.py at the step's end, like the grounds'. Newton's matrix is
-each shell's plus the touching pairs' projected barrier Hessians, solved by the joint CG
+friction, damping; the gas's rank-one and the damping's rank-6 terms stay per shell) and ``B_c`` the
+point-triangle and edge-edge barrier of contact.py at the step's end, like the grounds'. Newton's
+matrix is each shell's plus the touching pairs' projected barrier Hessians, solved by the joint CG
 (jointcg.py; no envelope fallback: a CG that does not converge rejects the step). Each Newton
-correction, and the predictor, is a straight motion: the broad phase (broadphase.py) lists the
-pairs that may come within ``dhat`` along it, and its step is cut so that no vertex reaches a
-ground (ground.max_step) nor a triangle (contact.max_step), then halved until ``Phi`` drops
-(Armijo), as implicit.py's. The step converges when every shell's residual passes implicit.py's
-test; friction's normal forces are lagged as there. The contact between shells is frictionless.
+correction, and the predictor, is a straight motion: the broad phase (broadphase.py) lists the pairs
+that may come within ``dhat`` along it, and its step is cut so that no vertex reaches a ground
+(ground.max_step) nor a triangle (contact.max_step), then halved until ``Phi`` drops (Armijo), as
+implicit.py's. The step converges when every shell's residual passes implicit.py's test; friction's
+normal forces are lagged as there. The contact between shells is frictionless.
 """
 
 import math
@@ -52,7 +52,7 @@ def energy(method, sts, jt, x):
     if not math.isfinite(total):
         return total
     cd = jt.candidates
-    return total + contact.energy(cd.pairs, cd.n_pairs[0], flat(x), jt.kappa, jt.dhat, jt.scratch)
+    return total + contact.energy(cd.pairs, cd.n_pairs[0], flat(x), jt.rest, jt.kappa, jt.dhat, jt.scratch)
 
 
 @kernel
@@ -68,6 +68,7 @@ def gradient(method, sts, jt, x, grad, blocks, hessian):
         pairs,
         count,
         flat(x),
+        jt.rest,
         jt.kappa,
         jt.dhat,
         flat(grad),
@@ -257,8 +258,8 @@ def gradient_pairs(jt, x, grad, blocks):
     """Adds the pairs' barrier gradient (N) at ``x`` to ``grad`` (S, V, 3)."""
     cd = jt.candidates
     contact.add_barrier(
-        cd.pairs, cd.n_pairs[0], flat(x), jt.kappa, jt.dhat, flat(grad), flat(blocks), jt.active, jt.hess,
-        jt.scratch, False,
+        cd.pairs, cd.n_pairs[0], flat(x), jt.rest, jt.kappa, jt.dhat, flat(grad), flat(blocks), jt.active,
+        jt.hess, jt.scratch, False,
     )  # fmt: skip
 
 
@@ -310,4 +311,5 @@ def pair_energy(jt: Joint, x: F64) -> float:
     x = np.ascontiguousarray(x, dtype=np.float64)
     cd = jt.candidates
     broadphase.find_pairs(cd, x.reshape(-1, 3), np.zeros((x.shape[0] * x.shape[1], 3)), jt.dhat, jt.box)
-    return float(contact.energy(cd.pairs, cd.n_pairs[0], x.reshape(-1, 3), jt.kappa, jt.dhat, jt.scratch))
+    n = cd.n_pairs[0]
+    return float(contact.energy(cd.pairs, n, x.reshape(-1, 3), jt.rest, jt.kappa, jt.dhat, jt.scratch))

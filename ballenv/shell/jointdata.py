@@ -15,7 +15,7 @@ from .broadphase import Candidates, make_candidates
 from .distance import PairScratch, make_scratch
 
 F64 = NDArray[np.float64]
-PAIRS_PER_VERTEX = 8  # room for candidate pairs at the start (doubled when they do not fit)
+PAIRS_PER_VERTEX = 8  # room for candidate pairs at the start (grown when they do not fit, groups.py)
 TOUCHING_PER_VERTEX = 2  # and for touching pairs' matrices
 
 
@@ -32,6 +32,7 @@ class Joint(NamedTuple):
     force: F64  # (S, V, 3) N: the contact force at the step's end
     rhs: F64  # (S, V, 3) N
     cg: F64  # (4, S, V, 3) the joint CG's scratch
+    rest: F64  # (S V, 3) m: the shells' rest positions (the edge-edge mollifier)
     kappa: F64  # (S,) N/m: each shell's barrier stiffness
     dhat: float  # m
     candidates: Candidates
@@ -43,18 +44,25 @@ class Joint(NamedTuple):
 
 
 def make_joint(
-    triangles: NDArray[np.int64], n_vertices: int, kappa: F64, dhat: float, self_contact: bool, room: int = 1
+    mesh: tuple[NDArray[np.int64], NDArray[np.int64]],
+    rest: F64,
+    kappa: F64,
+    dhat: float,
+    self_contact: bool,
+    room: int = 1,
 ) -> Joint:
-    """The records of a group of ``len(kappa)`` shells of the mesh ``triangles`` over ``n_vertices``
-    vertices, with ``room`` times the starting room for pairs."""
-    s = len(kappa)
+    """The records of a group of ``len(kappa)`` shells of the mesh ``(triangles, edges)``, at rest
+    at ``rest`` (S, V, 3) m, with ``room`` times the starting room for pairs."""
+    s, n_vertices = len(kappa), rest.shape[1]
+    triangles, edges = mesh
     z = np.zeros
     v3, b3 = (s, n_vertices, 3), (s, n_vertices, 3, 3)
     pairs = room * PAIRS_PER_VERTEX * s * n_vertices
     touching = room * TOUCHING_PER_VERTEX * s * n_vertices
     return Joint(
         z(v3), z(v3), z(v3), z(v3), z(b3), z(v3), z(b3), z(v3), z(v3), z((4,) + v3),
-        np.asarray(kappa, dtype=np.float64), float(dhat), make_candidates(triangles, s, pairs, self_contact),
+        np.ascontiguousarray(rest.reshape(-1, 3), dtype=np.float64), np.asarray(kappa, dtype=np.float64),
+        float(dhat), make_candidates(triangles, edges, s, pairs, self_contact),
         z((touching, 4), dtype=np.int64), z((touching, 12, 12)), z(1, dtype=np.int64), make_scratch(),
         z((2, 3)),
     )  # fmt: skip

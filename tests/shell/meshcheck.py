@@ -1,0 +1,73 @@
+"""Independent geometric checks of intersection-freeness for the contact tests (NumPy, brute
+force): the generalized winding number of points about a closed mesh, segment-triangle crossings
+and point-triangle distances (by the plane and the three edges, not by feature regions)."""
+
+import numpy as np
+
+
+def winding_numbers(points, x, triangles):
+    """The winding number (1 inside, 0 outside) of each point (P, 3) about the closed mesh."""
+    a = x[triangles[:, 0]][None] - points[:, None]
+    b = x[triangles[:, 1]][None] - points[:, None]
+    c = x[triangles[:, 2]][None] - points[:, None]
+    la, lb, lc = (np.linalg.norm(u, axis=2) for u in (a, b, c))
+    det = np.einsum("ptk,ptk->pt", a, np.cross(b, c))
+    den = la * lb * lc + np.einsum("ptk,ptk->pt", a, b) * lc
+    den += np.einsum("ptk,ptk->pt", b, c) * la + np.einsum("ptk,ptk->pt", c, a) * lb
+    return (2.0 * np.arctan2(det, den)).sum(axis=1) / (4.0 * np.pi)
+
+
+def edges_of(triangles):
+    e = np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]])
+    return np.unique(np.sort(e, axis=1), axis=0)
+
+
+def segment_crossings(p, q, x, triangles):
+    """How many segments ``p -> q`` (E, 3) cross a triangle of the mesh (Moller-Trumbore)."""
+    a, b, c = x[triangles[:, 0]], x[triangles[:, 1]], x[triangles[:, 2]]
+    d = (q - p)[:, None]
+    e1, e2 = (b - a)[None], (c - a)[None]
+    h = np.cross(d, e2)
+    det = np.einsum("etk,etk->et", e1, h)
+    s = p[:, None] - a[None]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        u = np.einsum("etk,etk->et", s, h) / det
+        qv = np.cross(s, e1)
+        v = np.einsum("etk,etk->et", d, qv) / det
+        t = np.einsum("etk,etk->et", e2, qv) / det
+        hit = (np.abs(det) > 0) & (u >= 0) & (v >= 0) & (u + v <= 1) & (t >= 0) & (t <= 1)
+    return int(hit.sum())
+
+
+def _segment_distance(p, a, b):
+    ab = b - a
+    t = np.clip(np.einsum("...k,...k->...", p - a, ab) / np.einsum("...k,...k->...", ab, ab), 0.0, 1.0)
+    return np.linalg.norm(p - a - t[..., None] * ab, axis=-1)
+
+
+def min_point_triangle_distance(points, x, triangles):
+    """The smallest distance (m) between the points (P, 3) and the triangles of the mesh."""
+    p = points[:, None]
+    a, b, c = (x[triangles[:, k]][None] for k in range(3))
+    n = np.cross(b - a, c - a)
+    n = n / np.linalg.norm(n, axis=-1, keepdims=True)
+    h = np.einsum("ptk,ptk->pt", p - a, n)
+    foot = p - h[..., None] * n
+    inside = np.ones(h.shape, dtype=bool)
+    for u, w in ((a, b), (b, c), (c, a)):
+        inside &= np.einsum("ptk,ptk->pt", np.cross(w - u, foot - u), n) >= 0
+    edge = np.minimum(
+        np.minimum(_segment_distance(p, a, b), _segment_distance(p, b, c)), _segment_distance(p, c, a)
+    )
+    return float(np.where(inside, np.abs(h), edge).min())
+
+
+def check_apart(xa, xb, triangles):
+    """``(largest winding number of a vertex of either about the other, edge crossings, smallest
+    vertex-triangle distance m)`` of two shells' vertices (V, 3) on the mesh ``triangles``."""
+    edges = edges_of(triangles)
+    wind = max(winding_numbers(xa, xb, triangles).max(), winding_numbers(xb, xa, triangles).max())
+    cross = segment_crossings(xa[edges[:, 0]], xa[edges[:, 1]], xb, triangles)
+    cross += segment_crossings(xb[edges[:, 0]], xb[edges[:, 1]], xa, triangles)
+    low = min(min_point_triangle_distance(xa, xb, triangles), min_point_triangle_distance(xb, xa, triangles))
+    return float(wind), cross, low
