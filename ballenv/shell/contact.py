@@ -41,9 +41,12 @@ largest such ``alpha`` a pair allows; the smallest over the candidates caps the 
 
 import math
 
+import numpy as np
+from numpy.typing import NDArray
+
 from ..physics.base.jit import kernel
 from ..physics.walls.self_barrier import beta, beta_curvature, beta_slope
-from .distance import EDGE_EDGE, cross_derivatives, derivatives, distance2, gather
+from .distance import EDGE_EDGE, cross_derivatives, derivatives, distance2, gather, make_scratch
 from .projection import project_psd
 
 EDGE_MOLLIFIER = 1e-3  # eps of the edge-edge mollifier against the rest edges' |e_1|^2 |e_2|^2
@@ -251,3 +254,18 @@ def min_distance(pairs, count, x, sc):
         gather(x, pairs[p], sc.pos)
         low = min(low, distance2(sc, pairs[p, 4]))
     return math.sqrt(low)
+
+
+def pair_barrier(
+    pos: NDArray[np.float64], kind: int, kappa: float, dhat: float, rest: NDArray[np.float64], project: bool
+) -> tuple[float, NDArray[np.float64], NDArray[np.float64]]:
+    """``(B J, grad B (12,) N, Hess B (12, 12) N/m)`` of one pair of ``kind`` at ``pos`` (4, 3) m
+    (rest positions ``rest`` (4, 3) m, for the edge-edge mollifier), projected if ``project``."""
+    sc = make_scratch()
+    sc.pos[:] = pos
+    idx = np.array([0, 1, 2, 3, kind], dtype=np.int64)
+    b = float(_pair(sc, idx, np.ascontiguousarray(rest, dtype=np.float64), kappa, dhat, project))
+    if b > 0.0 and kind == EDGE_EDGE:
+        q = min(float(_cross(sc.pos)) / float(_mollifier_scale(rest, idx)), 1.0)
+        b *= (2.0 - q) * q
+    return b, sc.g.copy(), sc.h.copy()

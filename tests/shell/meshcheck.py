@@ -45,8 +45,8 @@ def _segment_distance(p, a, b):
     return np.linalg.norm(p - a - t[..., None] * ab, axis=-1)
 
 
-def min_point_triangle_distance(points, x, triangles):
-    """The smallest distance (m) between the points (P, 3) and the triangles of the mesh."""
+def point_triangle_distances(points, x, triangles):
+    """The distances (P, T) m between the points (P, 3) and the triangles of the mesh."""
     p = points[:, None]
     a, b, c = (x[triangles[:, k]][None] for k in range(3))
     n = np.cross(b - a, c - a)
@@ -59,7 +59,12 @@ def min_point_triangle_distance(points, x, triangles):
     edge = np.minimum(
         np.minimum(_segment_distance(p, a, b), _segment_distance(p, b, c)), _segment_distance(p, c, a)
     )
-    return float(np.where(inside, np.abs(h), edge).min())
+    return np.where(inside, np.abs(h), edge)
+
+
+def min_point_triangle_distance(points, x, triangles):
+    """The smallest distance (m) between the points (P, 3) and the triangles of the mesh."""
+    return float(point_triangle_distances(points, x, triangles).min())
 
 
 def check_apart(xa, xb, triangles):
@@ -71,3 +76,27 @@ def check_apart(xa, xb, triangles):
     cross += segment_crossings(xb[edges[:, 0]], xb[edges[:, 1]], xa, triangles)
     low = min(min_point_triangle_distance(xa, xb, triangles), min_point_triangle_distance(xb, xa, triangles))
     return float(wind), cross, low
+
+
+def check_self(x, triangles):
+    """``(crossings of an edge and a triangle sharing no vertex, smallest distance m of a vertex
+    from a triangle that does not hold it)`` of one shell's vertices (V, 3)."""
+    edges = edges_of(triangles)
+    a, b, c = x[triangles[:, 0]], x[triangles[:, 1]], x[triangles[:, 2]]
+    p, q = x[edges[:, 0]], x[edges[:, 1]]
+    d = (q - p)[:, None]
+    e1, e2 = (b - a)[None], (c - a)[None]
+    h = np.cross(d, e2)
+    det = np.einsum("etk,etk->et", e1, h)
+    s = p[:, None] - a[None]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        u = np.einsum("etk,etk->et", s, h) / det
+        qv = np.cross(s, e1)
+        v = np.einsum("etk,etk->et", d, qv) / det
+        t = np.einsum("etk,etk->et", e2, qv) / det
+        hit = (np.abs(det) > 0) & (u >= 0) & (v >= 0) & (u + v <= 1) & (t >= 0) & (t <= 1)
+    shared = (edges[:, None, :, None] == triangles[None, :, None, :]).any(axis=(2, 3))
+    crossings = int((hit & ~shared).sum())
+    distances = point_triangle_distances(x, x, triangles)
+    holds = (np.arange(len(x))[:, None, None] == triangles[None]).any(axis=2)
+    return crossings, float(distances[~holds].min())
