@@ -12,15 +12,16 @@ A candidate pair (broadphase.py) of a vertex and a triangle, or of two edges, at
 
     grad B = kappa beta'(y) g,   Hess B = kappa (beta''(y) / dhat^2 g g^T + beta'(y) Hess d^2)
 
-An edge-edge pair's is mollified as in Incremental Potential Contact, ``m(c) B`` with
-``c = |e_1 x e_2|^2`` (m^4), ``m = (2 - c / eps) c / eps`` below ``eps = EDGE_MOLLIFIER |e_1|^2
-|e_2|^2`` (rest lengths) and 1 above, so that it vanishes smoothly as the edges turn parallel (where
-their distance's Hessian is singular and the point-triangle pairs of their ends take over). Each
-pair's matrix is projected to the nearest positive semi-definite one (projection.py) for Newton's
-matrix (the distance's curvature enters with ``beta' < 0``). ``B`` is ``C^1`` where the closest
-features change and ``C^2`` elsewhere; it grows without bound as ``d -> 0``, so no state of finite
-energy has a vertex on a triangle or an edge on an edge of another shell (or of its own, with
-self-contact).
+An edge-edge pair's is mollified as in Incremental Potential Contact, ``m(c) B`` with ``c = |e_1 x
+e_2|^2`` (m^4), ``m = (2 - c / eps) c / eps`` below ``eps = EDGE_MOLLIFIER |e_1|^2 |e_2|^2`` (rest
+lengths) and 1 above, so that it vanishes smoothly as the edges turn parallel (where their
+distance's Hessian is singular and the point-triangle pairs of their ends take over). Each pair's
+matrix is projected to the nearest positive semi-definite one (projection.py; in the span of ``w (x)
+e_a`` and ``f_x theta`` of distance.py, at most five dimensions, which holds ``g`` and ``Hess d^2``,
+unless mollified) for Newton's matrix (the distance's curvature enters with ``beta' < 0``). ``B`` is
+``C^1`` where the closest features change and ``C^2`` elsewhere; it grows without bound as ``d ->
+0``, so no state of finite energy has a vertex on a triangle or an edge on an edge of another shell
+(or of its own, with self-contact).
 
 **Why both kinds.** Two closed triangle meshes intersect only if an edge of one crosses a triangle
 of the other. Between two balls pressed face to face the point-triangle pairs hold every vertex
@@ -46,8 +47,8 @@ from numpy.typing import NDArray
 
 from ..physics.base.jit import kernel
 from ..physics.walls.self_barrier import beta, beta_curvature, beta_slope
-from .distance import EDGE_EDGE, cross_derivatives, derivatives, distance2, gather, make_scratch
-from .projection import project_psd
+from .distance import EDGE_EDGE, cross_derivatives, derivatives, distance2, gather, make_scratch, range_basis
+from .projection import project_psd, project_psd_in
 
 EDGE_MOLLIFIER = 1e-3  # eps of the edge-edge mollifier against the rest edges' |e_1|^2 |e_2|^2
 CCD_SAFETY = 0.8  # a pair's distance may fall to 1 - CCD_SAFETY of its start along a motion
@@ -116,10 +117,11 @@ def _barrier_hessian(sc, k, y, dhat):
 @kernel
 def _mollify(sc, b, eps):
     """``m(c) B`` of an edge-edge pair: its gradient into ``sc.g`` and Hessian into ``sc.h``, from
-    ``B`` (J), ``grad B`` and ``Hess B`` there (module doc)."""
+    ``B`` (J), ``grad B`` and ``Hess B`` there (module doc); False (nothing changed) where
+    ``m = 1``."""
     c = cross_derivatives(sc)
     if c >= eps:
-        return
+        return False
     q = c / eps
     m, dm, ddm = (2.0 - q) * q, (2.0 - 2.0 * q) / eps, -2.0 / (eps * eps)
     for p in range(12):
@@ -130,6 +132,7 @@ def _mollify(sc, b, eps):
             )  # fmt: skip
     for p in range(12):
         sc.g[p] = m * sc.g[p] + b * dm * sc.gc[p]
+    return True
 
 
 @kernel
@@ -148,10 +151,12 @@ def _pair(sc, pair, rest, k, dhat, hessian):
     for p in range(12):
         sc.g[p] *= c2
     b = k * reach * beta(y)
-    if pair[4] == EDGE_EDGE:
-        _mollify(sc, b, _mollifier_scale(rest, pair))
-    if hessian:
+    mollified = pair[4] == EDGE_EDGE and _mollify(sc, b, _mollifier_scale(rest, pair))
+    if hessian and mollified:
         project_psd(sc.h, sc.vecs, sc.lam)
+    elif hessian:
+        range_basis(sc)
+        project_psd_in(sc.h, sc.basis, sc.small, sc.small_vecs, sc.lam)
     return b
 
 

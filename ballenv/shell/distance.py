@@ -33,6 +33,7 @@ from numpy.typing import NDArray
 from ..physics.base.jit import kernel
 
 POINT_TRIANGLE, EDGE_EDGE = 0, 1  # the kinds of pair
+RANGE_TOL = 1e-9  # a direction of f_x theta left after orthogonalisation below this share is dropped
 
 
 class PairScratch(NamedTuple):
@@ -52,6 +53,9 @@ class PairScratch(NamedTuple):
     hc: NDArray[np.float64]  # (12, 12) m^2: its Hessian
     vecs: NDArray[np.float64]  # (12, 12) eigenvectors (projection.py)
     lam: NDArray[np.float64]  # (12,) eigenvalues
+    basis: NDArray[np.float64]  # (5, 12) an orthonormal basis of Hess d^2's range (range_basis)
+    small: NDArray[np.float64]  # (5, 5)
+    small_vecs: NDArray[np.float64]  # (5, 5)
 
 
 def make_scratch() -> PairScratch:
@@ -59,7 +63,7 @@ def make_scratch() -> PairScratch:
     z = np.zeros
     return PairScratch(
         z((4, 3)), z(4), z(3), z((2, 3)), z((12, 2)), np.zeros(5, dtype=np.int64), z(2), z(2), z(12),
-        z((12, 12)), z(12), z((12, 12)), z((12, 12)), z(12),
+        z((12, 12)), z(12), z((12, 12)), z((12, 12)), z(12), z((5, 12)), z((5, 5)), z((5, 5)),
     )  # fmt: skip
 
 
@@ -206,6 +210,37 @@ def derivatives(sc, kind):
             v -= f[p, 0] * (i00 * f[q, 0] + i01 * f[q, 1]) + f[p, 1] * (i01 * f[q, 0] + i11 * f[q, 1])
             sc.h[p, q] = sc.h[q, p] = v
     return d2
+
+
+@kernel
+def range_basis(sc):
+    """An orthonormal basis (rows, zero rows where the span is smaller) of the span of ``w (x) e_a``
+    (a = 1, 2, 3) and the columns of ``f_x theta`` into ``sc.basis`` (5, 12): it holds the range of
+    ``Hess d^2`` and ``grad d^2`` (module doc), after :func:`derivatives`."""
+    b, w, k = sc.basis, sc.w, sc.feature[0]
+    b[:] = 0.0
+    norm = math.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2] + w[3] * w[3])
+    for a in range(3):
+        for m in range(4):
+            b[a, 3 * m + a] = w[m] / norm
+    for j in range(k):
+        row = 3 + j
+        size = 0.0
+        for p in range(12):
+            b[row, p] = sc.f[p, j]
+            size += sc.f[p, j] * sc.f[p, j]
+        for i in range(row):
+            dot = 0.0
+            for p in range(12):
+                dot += b[i, p] * b[row, p]
+            for p in range(12):
+                b[row, p] -= dot * b[i, p]
+        left = 0.0
+        for p in range(12):
+            left += b[row, p] * b[row, p]
+        scale = 1.0 / math.sqrt(left) if left > RANGE_TOL * RANGE_TOL * size else 0.0
+        for p in range(12):
+            b[row, p] *= scale
 
 
 @kernel

@@ -4,8 +4,8 @@ A contact pair's barrier Hessian (contact.py) is indefinite where the distance's
 enters with the barrier's negative slope; Newton's matrix must stay positive definite for CG, so,
 as Incremental Potential Contact does, each pair's matrix ``H = Q diag(lambda) Q^T`` is replaced by
 ``Q diag(max(lambda, 0)) Q^T``. The eigenvalues come from cyclic Jacobi rotations (Golub & Van
-Loan, 8.5) until the off-diagonal part is ``JACOBI_TOL`` of the matrix's norm, in place, without
-allocating.
+Loan, 8.5) until the off-diagonal part is ``JACOBI_TOL`` of the matrix's norm (entries below
+``JACOBI_TOL / n`` of it are set to zero instead of rotated), in place, without allocating.
 """
 
 import math
@@ -62,10 +62,13 @@ def project_psd(a, v, lam):
         off, total = _off_diagonal(a)
         if off <= JACOBI_TOL * JACOBI_TOL * total:
             break
+        small = JACOBI_TOL * math.sqrt(total) / n
         for p in range(n - 1):
             for q in range(p + 1, n):
-                if a[p, q] != 0.0:
+                if abs(a[p, q]) > small:
                     _rotate(a, v, p, q)
+                else:
+                    a[p, q] = a[q, p] = 0.0  # below the tolerance: no rotation (nor subnormal numbers)
     lowest = 0.0
     for k in range(n):
         lowest = min(lowest, a[k, k])
@@ -75,5 +78,34 @@ def project_psd(a, v, lam):
             s = 0.0
             for k in range(n):
                 s += v[p, k] * lam[k] * v[q, k]
+            a[p, q] = a[q, p] = s
+    return lowest
+
+
+@kernel
+def project_psd_in(a, basis, small, vecs, lam):
+    """:func:`project_psd` of a symmetric ``a`` (n, n) whose range lies in the span of the rows of
+    ``basis`` (k, n), orthonormal or zero: ``a = B^T S B`` with ``S = B a B^T`` (k, k), so the
+    projection is ``B^T S_+ B`` (eigenvalues of a k x k matrix instead of an n x n one). ``small``,
+    ``vecs`` (k, k) and ``lam`` (k,) scratch. Returns the most negative eigenvalue (0 if none)."""
+    k, n = basis.shape
+    for i in range(k):
+        for j in range(i, k):
+            s = 0.0
+            for p in range(n):
+                if basis[i, p] == 0.0:
+                    continue
+                t = 0.0
+                for q in range(n):
+                    t += a[p, q] * basis[j, q]
+                s += basis[i, p] * t
+            small[i, j] = small[j, i] = s
+    lowest = project_psd(small, vecs, lam)
+    for p in range(n):
+        for q in range(p, n):
+            s = 0.0
+            for i in range(k):
+                for j in range(k):
+                    s += basis[i, p] * small[i, j] * basis[j, q]
             a[p, q] = a[q, p] = s
     return lowest

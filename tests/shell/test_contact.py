@@ -198,3 +198,12 @@ def test_a_collapsing_ball_with_self_contact_never_passes_its_skin_through_itsel
     assert min(low for _, low in checks) < 1e-3  # opposite sides came within dhat: the barrier acted
     without, _ = collapse(False)
     assert max(check_self(x, triangles)[0] for x in without.x[::10, 0]) > 0  # it does cross itself
+
+
+@pytest.mark.parametrize(("pos", "kind"), barrier_cases())
+def test_the_barrier_hessian_is_projected_to_the_nearest_positive_semi_definite_matrix(pos, kind):
+    kappa, dhat = 1.5e4, 1e-3
+    _, _, h = pair_barrier(pos, kind, kappa, dhat, pos, False)
+    _, _, projected = pair_barrier(pos, kind, kappa, dhat, pos, True)
+    lam, q = np.linalg.eigh(h)
+    np.testing.assert_allclose(projected, (q * np.maximum(lam, 0.0)) @ q.T, atol=1e-9 * lam.max())
