@@ -303,13 +303,3 @@ def step(
         wk = st.work
         out.append(implicit.StepResult(jt.x[k].copy(), wk.v1.copy(), wk.a1.copy(), jt.force[k].copy(), *work))
     return out
-
-
-def pair_energy(jt: Joint, x: F64) -> float:
-    """The contact barrier's energy (J) at ``x`` (S, V, 3) over the candidates of the motion to
-    ``x`` from ``x`` (its pairs within ``dhat``)."""
-    x = np.ascontiguousarray(x, dtype=np.float64)
-    cd = jt.candidates
-    broadphase.find_pairs(cd, x.reshape(-1, 3), np.zeros((x.shape[0] * x.shape[1], 3)), jt.dhat, jt.box)
-    n = cd.n_pairs[0]
-    return float(contact.energy(cd.pairs, n, x.reshape(-1, 3), jt.rest, jt.kappa, jt.dhat, jt.scratch))
