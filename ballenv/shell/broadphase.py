@@ -3,15 +3,17 @@ triangle (point-triangle) or of two edges (edge-edge), may come within the barri
 (m) during a straight motion ``x + alpha dx``, ``0 <= alpha <= 1``, of every vertex.
 
 The shells of a group share one mesh (``T`` triangles, ``E`` edges over ``V`` vertices); a vertex is
-numbered ``k V + i`` (shell ``k``, vertex ``i``) in the group's positions ``x`` (S V, 3). The boxes of
-the triangles, and of the edges, around their corners at ``x`` and ``x + dx``, grown by ``dhat``, go
-into two uniform grids hashed into buckets (cells of the largest triangle box's size, so that a box
-meets at most 2 x 2 x 2 cells; counting sorts into preallocated arrays); each vertex's box around
-``x`` and ``x + dx`` is tested against the triangles of the buckets its cells hash to, each edge's
-against the edges. A candidate is a pair whose boxes overlap, of elements of different shells, or,
-with self-contact, of one shell's that share no vertex (pairs sharing a vertex are left to the
-skin's own stiffness). The cost is linear in the vertices and the candidates; a pair that is not a
-candidate stays farther than ``dhat`` apart along the whole motion.
+numbered ``k V + i`` (shell ``k``, vertex ``i``) in the group's positions ``x`` (S V, 3). The boxes
+of the triangles, and of the edges, around their corners at ``x`` and ``x + dx``, grown by ``dhat``,
+go into two uniform grids hashed into buckets (cells of the largest triangle box's size, so that a
+box meets at most 2 x 2 x 2 cells; counting sorts into preallocated arrays); each vertex's box
+around ``x`` and ``x + dx`` is tested against the triangles of the buckets its cells hash to, each
+edge's against the edges; without self-contact, only the elements whose boxes meet another shell's
+box (around its triangles' boxes) go into the grids or are tested. A candidate is a pair whose boxes
+overlap, of elements of different shells, or, with self-contact, of one shell's that share no vertex
+(pairs sharing a vertex are left to the skin's own stiffness). The cost is linear in the vertices
+and the candidates; a pair that is not a candidate stays farther than ``dhat`` apart along the whole
+motion.
 """
 
 from typing import NamedTuple
@@ -45,6 +47,8 @@ class Candidates(NamedTuple):
     triangles: Grid
     edges: Grid
     points: NDArray[np.int64]  # (V, 1) each vertex as an element
+    shell_lo: NDArray[np.float64]  # (S, 3) m: each shell's box, around its triangles' boxes
+    shell_hi: NDArray[np.float64]  # (S, 3) m
     pairs: NDArray[np.int64]  # (P, 5): the pair's four vertices (group numbering), its kind
     n_pairs: NDArray[np.int64]  # (1,): candidates in ``pairs``, -1 if they did not fit
     self_contact: bool
@@ -67,7 +71,9 @@ def make_candidates(
     points = np.arange(int(triangles.max()) + 1, dtype=np.int64)[:, None]
     pairs = np.zeros((capacity, 5), dtype=np.int64)
     n = np.zeros(1, dtype=np.int64)
-    return Candidates(_grid(triangles, n_shells), _grid(edges, n_shells), points, pairs, n, self_contact)
+    boxes = np.zeros((n_shells, 3)), np.zeros((n_shells, 3))
+    grids = _grid(triangles, n_shells), _grid(edges, n_shells)
+    return Candidates(*grids, points, *boxes, pairs, n, self_contact)
 
 
 @kernel(inline="always")
@@ -100,13 +106,45 @@ def _boxes(grid, x, dx, dhat):
 
 
 @kernel
-def _fill(grid, cell):
-    """Counting sort of the elements into the buckets of the cells their boxes meet."""
+def _shell_boxes(cd):
+    """Each shell's box around its triangles' grown boxes."""
+    grid = cd.triangles
+    n = grid.elements.shape[0]
+    cd.shell_lo[:] = np.inf
+    cd.shell_hi[:] = -np.inf
+    for e in range(grid.lo.shape[0]):
+        k = e // n
+        for a in range(3):
+            cd.shell_lo[k, a] = min(cd.shell_lo[k, a], grid.lo[e, a])
+            cd.shell_hi[k, a] = max(cd.shell_hi[k, a], grid.hi[e, a])
+
+
+@kernel
+def _near_others(cd, k, lo, hi):
+    """Whether the box ``lo, hi`` meets another shell's box than ``k``'s (always, with
+    self-contact): elements far from every other shell have no candidate."""
+    if cd.self_contact:
+        return True
+    for j in range(cd.shell_lo.shape[0]):
+        if j == k:
+            continue
+        if lo[0] <= cd.shell_hi[j, 0] and cd.shell_lo[j, 0] <= hi[0] and lo[1] <= cd.shell_hi[j, 1]:
+            if cd.shell_lo[j, 1] <= hi[1] and lo[2] <= cd.shell_hi[j, 2] and cd.shell_lo[j, 2] <= hi[2]:
+                return True
+    return False
+
+
+@kernel
+def _fill(cd, grid, cell):
+    """Counting sort of the elements near another shell into the buckets of the cells their boxes
+    meet."""
     mask = grid.fill.shape[0] - 1
     grid.fill[:] = 0
     for stage in range(2):
         for e in range(grid.lo.shape[0]):
             lo, hi = grid.lo[e], grid.hi[e]
+            if not _near_others(cd, e // grid.elements.shape[0], lo, hi):
+                continue
             for ix in range(_cell(lo[0], cell), _cell(hi[0], cell) + 1):
                 for iy in range(_cell(lo[1], cell), _cell(hi[1], cell) + 1):
                     for iz in range(_cell(lo[2], cell), _cell(hi[2], cell) + 1):
@@ -198,6 +236,8 @@ def _sweep(cd, grid, query, x, dx, cell, kind, count, box):
                 v = base + query[q % query.shape[0], c]
                 box[0, a] = min(box[0, a], x[v, a], x[v, a] + dx[v, a])
                 box[1, a] = max(box[1, a], x[v, a], x[v, a] + dx[v, a])
+        if not _near_others(cd, q // query.shape[0], box[0], box[1]):
+            continue
         count = _query(cd, grid, query, q, box, cell, kind, count, n_vertices)
         if count < 0:
             return -1
@@ -215,8 +255,9 @@ def find_pairs(cd, x, dx, dhat, box):
         for a in range(3):
             side = max(side, abs(dx[v, a]))
     cell = CELL_MARGIN * side
-    _fill(cd.triangles, cell)
-    _fill(cd.edges, cell)
+    _shell_boxes(cd)
+    _fill(cd, cd.triangles, cell)
+    _fill(cd, cd.edges, cell)
     count = _sweep(cd, cd.triangles, cd.points, x, dx, cell, POINT_TRIANGLE, 0, box)
     if count >= 0:
         count = _sweep(cd, cd.edges, cd.edges.elements, x, dx, cell, EDGE_EDGE, count, box)
