@@ -8,9 +8,11 @@ modes (modes.py). The dynamics: the validated descriptions ``Shell``, ``Ground``
 (scene.py); grounds' barriers (ground.py), lagged Coulomb friction (friction.py) and damping of the
 deformation only (damping.py); the implicit step, backward Euler or generalized-alpha
 (implicit.py), its incremental potential (increment.py), its records (stepdata.py) and its linear
-solve (stepsolve.py); the energy budget (budget.py); events (events.py); ``simulate`` and
-``Trajectory`` (simulation.py); fidelity presets (presets.py); regulation balls and their drop
-tests (balls.py). SI units.
+solve (stepsolve.py); contact between shells and within one: distances (distance.py), the barrier
+and its collision detection (contact.py, projection.py), the broad phase (broadphase.py) and the
+joint step of shells that may touch (groups.py, joint.py, jointdata.py, jointcg.py); the energy
+budget (budget.py); events (events.py); ``simulate`` and ``Trajectory`` (simulation.py); fidelity
+presets (presets.py); regulation balls and their drop tests (balls.py). SI units.
 """
 
 from ..physics.base.compile_notice import install as _install_compile_notice

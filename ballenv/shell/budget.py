@@ -3,17 +3,20 @@
 Nothing in a shell scene adds energy: the gas, gravity and the barriers are potentials; damping
 and friction only remove it (the grounds are fixed). So a shell's energy (kinetic + stretching +
 bending + gas + gravity + barriers, J: ``implicit.total_energy``) may never rise above its value
-at the start, its budget. Generalized-alpha is not energy-stable for a
+at the start, its budget; shells that have stepped jointly (they may have touched and exchanged
+energy) share theirs: their energies and the barrier between them may not rise above the sum of
+their budgets. Generalized-alpha is not energy-stable for a
 nonlinear shell: a fast-spinning ball gains energy of order ``h^2`` over its first revolutions
 (the discrete rotation stretches it) before the gain levels off. An accepted step whose
 energy lies above the budget by ``excess`` (J) is corrected as the ring's
 (``ballenv.physics.step.energy_budget``), keeping the momentum:
 
-* if the kinetic energy of the shell's deformation ``K_d = 1/2 v^T (M - W W^T) v``
-  (``W`` damping.py's rigid modes at the step's end) exceeds it, the velocity relative to the
-  rigid motion is scaled by ``s = sqrt(1 - excess / K_d)`` (linear and angular momentum kept);
-* else, if the kinetic energy relative to the centre of mass ``K_c`` exceeds it, the velocities
-  relative to the centre's are scaled by ``sqrt(1 - excess / K_c)`` (spin lowered by that factor);
+* if the kinetic energy of the shells' deformation ``K_d = sum 1/2 v^T (M - W W^T) v``
+  (``W`` damping.py's rigid modes of each at the step's end) exceeds it, the velocities relative to
+  their rigid motions are scaled by ``s = sqrt(1 - excess / K_d)`` (each shell's linear and angular
+  momentum kept);
+* else, if the kinetic energy relative to their centres of mass ``K_c`` exceeds it, the velocities
+  relative to the centres' are scaled by ``sqrt(1 - excess / K_c)`` (spins lowered by that factor);
 * else an excess within round-off (``ROUND_OFF`` of the energy's scale ``p_abs V0 + K``) is kept.
 
 A larger gain than ``ENERGY_GROWTH_TOL`` of ``K_c`` (or one that cannot be paid) is a spurious
@@ -28,8 +31,28 @@ from .implicit import total_energy
 from .stepdata import ShellStep
 
 F64 = NDArray[np.float64]
-ENERGY_GROWTH_TOL = 1e-2  # the largest gain of a step, relative to the kinetic energy about the centre
+ENERGY_GROWTH_TOL = 1e-2  # the largest gain of a step, relative to the kinetic energy about the centres
 ROUND_OFF = 1e-12  # relative to p_abs V0 + K
+
+
+class Sharing:
+    """Which shells share a budget: disjoint sets of shell indices, joined for good."""
+
+    def __init__(self, n_shells: int) -> None:
+        self.label = list(range(n_shells))
+
+    def join(self, group: list[int]) -> None:
+        """Puts the shells of ``group`` (and those sharing with them) in one set."""
+        old = {self.label[k] for k in group}
+        new = min(old)
+        self.label = [new if label in old else label for label in self.label]
+
+    def sets(self) -> list[list[int]]:
+        """The sets, each sorted, ordered by their first shell."""
+        out: dict[int, list[int]] = {}
+        for k, label in enumerate(self.label):
+            out.setdefault(label, []).append(k)
+        return list(out.values())
 
 
 def energies(steps: list[ShellStep], x: F64, v: F64) -> list[float]:
@@ -56,19 +79,24 @@ def _kinetic(st: ShellStep, u: F64) -> float:
     return 0.5 * float(np.sum(st.problem.model.mass[:, None] * u * u))
 
 
-def hold(st: ShellStep, x: F64, v: F64, energy: float, budget: float) -> bool:
-    """Holds a shell's state ``(x, v)`` (V, 3) of energy ``energy`` (J) to its ``budget`` (J),
-    scaling ``v`` in place as the module doc says; False if the step must be rejected."""
+def hold(steps: list[ShellStep], xs: list[F64], vs: list[F64], energy: float, budget: float) -> bool:
+    """Holds the states ``(xs[k], vs[k])`` (V, 3) of shells that share a budget (``steps``) of
+    energy ``energy`` (J) to ``budget`` (J), scaling each ``vs[k]`` in place by the same factor as
+    the module doc says; False if the step must be rejected."""
     excess = energy - budget
     if excess <= 0.0:
         return True
-    deform, centred = _deformation_velocity(st, x, v), _about_centre(st, v)
-    k_d, k_c = _kinetic(st, deform), _kinetic(st, centred)
-    model = st.problem.model
-    if excess <= ROUND_OFF * (model.absolute_pressure * model.rest_volume + k_c):
+    deform = [_deformation_velocity(st, x, v) for st, x, v in zip(steps, xs, vs, strict=True)]
+    centred = [_about_centre(st, v) for st, v in zip(steps, vs, strict=True)]
+    k_d = sum(_kinetic(st, u) for st, u in zip(steps, deform, strict=True))
+    k_c = sum(_kinetic(st, u) for st, u in zip(steps, centred, strict=True))
+    scale = sum(st.problem.model.absolute_pressure * st.problem.model.rest_volume for st in steps)
+    if excess <= ROUND_OFF * (scale + k_c):
         return True
     if excess > ENERGY_GROWTH_TOL * k_c:
         return False
-    pool, part = (k_d, deform) if k_d > excess else (k_c, centred)
-    v -= (1.0 - np.sqrt(1.0 - excess / pool)) * part
+    pool, parts = (k_d, deform) if k_d > excess else (k_c, centred)
+    keep = np.sqrt(1.0 - excess / pool)
+    for v, u in zip(vs, parts, strict=True):
+        v -= (1.0 - keep) * u
     return True

@@ -27,7 +27,7 @@ ground (ground.max_step) and halves it until ``Phi`` drops (Armijo) or, below ``
 ``tol (|g| + R / h^2)`` (m/s^2); otherwise :class:`StepFailure` (the step is rejected). The skin's
 element matrices ``K`` are those of the step's first iterate, evaluated again only when an
 iteration lowered the residual by less than ``1 / LAG_CONTRACTION`` (the stopping test, not the
-matrix, sets the solution); CG's tolerance follows the force the test asks for (:func:`_forcing`).
+matrix, sets the solution); CG's tolerance follows the force the test asks for (:func:`forcing`).
 The step is one compiled call (:func:`step_kernel`) on the preallocated records of stepdata.py.
 """
 
@@ -103,7 +103,7 @@ def search(method, st, sp, wk, e0):
         accept = e <= e0 - ARMIJO * alpha * slope
         if not accept and abs(e - e0) <= rounding:
             increment.incremental_gradient(method, st, sp, trial, wk, wk.trial_grad, wk.trial_blocks)
-            accept = _largest(wk.trial_grad) < g0
+            accept = largest(wk.trial_grad) < g0
         if accept:
             copy_into(x, trial)
             return e
@@ -112,7 +112,7 @@ def search(method, st, sp, wk, e0):
 
 
 @kernel
-def _largest(a):
+def largest(a):
     """The largest ``|a_ic|``."""
     out = 0.0
     for i in range(a.shape[0]):
@@ -122,7 +122,7 @@ def _largest(a):
 
 
 @kernel
-def _residual(grad, mass):
+def residual_acceleration(grad, mass):
     """The largest ``|grad_ic| / m_i`` (m/s^2), NaN if a component is not finite."""
     worst = 0.0
     for i in range(grad.shape[0]):
@@ -134,7 +134,7 @@ def _residual(grad, mass):
 
 
 @kernel
-def _forcing(grad, force_goal):
+def forcing(grad, force_goal):
     """CG's relative tolerance for a Newton direction from the gradient ``grad`` (N): a residual of
     ``FORCING`` times the force ``force_goal`` (N) that Newton's test asks for, within
     ``[CG_RTOL_MIN, CG_RTOL_MAX]``: near convergence the linear residual is what is left of the
@@ -161,7 +161,7 @@ def newton(method, st, sp, wk):
     e = increment.incremental(method, st, sp, wk.x, wk)
     for iteration in range(method.solver.newton_max_iter + 1):
         increment.incremental_gradient(method, st, sp, wk.x, wk, wk.grad, wk.blocks)
-        residual = _residual(wk.grad, mass)
+        residual = residual_acceleration(wk.grad, mass)
         if math.isnan(residual):
             return 1, iteration, cg_total, envelope_solves
         if residual <= goal:
@@ -171,7 +171,7 @@ def newton(method, st, sp, wk):
         # the envelope's fallback changes the element matrices: new ones after it
         fresh = iteration == 0 or envelope_solves > 0 or residual > LAG_CONTRACTION * previous
         previous = residual
-        rtol = _forcing(wk.grad, goal * lightest)
+        rtol = forcing(wk.grad, goal * lightest)
         iterations = increment.direction(st, sp, wk.x, wk.grad, wk.blocks, wk, wk.dx, fresh, rtol)
         if iterations == -2:
             return 3, iteration, cg_total, envelope_solves
@@ -184,7 +184,7 @@ def newton(method, st, sp, wk):
 
 
 @kernel
-def _lag_changed(st, sp, wk, weight):
+def lag_changed(st, sp, wk, weight):
     """The normal forces at ``wk.x`` into ``wk.lam``: True if one differs from the lagged ones by
     more than ``LAG_TOL`` of ``weight`` (N)."""
     ground.normal_forces(wk.x, st.normals, st.heights, st.dhat, st.kappa, wk.lam)
@@ -220,7 +220,7 @@ def step_kernel(method, st, x0, v0, a0, h):
         envelope_total += envelope_solves
         if status != 0:
             return status, newton_total, cg_total, envelope_total
-        if not frictional or lag == FRICTION_LAGS or not _lag_changed(st, sp, wk, weight):
+        if not frictional or lag == FRICTION_LAGS or not lag_changed(st, sp, wk, weight):
             break
         copy_into(sp.lam, wk.lam)
     wk.force[:] = 0.0
@@ -230,12 +230,12 @@ def step_kernel(method, st, x0, v0, a0, h):
         for c in range(3):
             wk.force[i, c] = -wk.force[i, c]
     increment.kinematics(method, sp, wk.x, wk.a1, wk.v1, wk.va)
-    wk.energy[0] = _energy(st, wk.x, wk.v1)
+    wk.energy[0] = end_energy(st, wk.x, wk.v1)
     return 0, newton_total, cg_total, envelope_total
 
 
 @kernel
-def _energy(st, x, v):
+def end_energy(st, x, v):
     """Kinetic + stretching + bending + gas + gravity + barrier energy (J) of ``(x, v)``."""
     p = st.problem
     kinetic = 0.0
@@ -321,4 +321,4 @@ def initial_acceleration(st: ShellStep, x: F64, v: F64) -> F64:
 
 def total_energy(st: ShellStep, x: F64, v: F64) -> float:
     """Kinetic + stretching + bending + gas + gravity + barrier energy (J)."""
-    return float(_energy(st, np.ascontiguousarray(x), np.ascontiguousarray(v)))
+    return float(end_energy(st, np.ascontiguousarray(x), np.ascontiguousarray(v)))

@@ -131,6 +131,24 @@ def direction(st, sp, x1, grad, blocks, wk, dx, fresh, rtol):
     ``BENDING_AGE`` fresh assemblies (``wk.bending_age``; -1: none kept). The mass term, the gas's
     rank-one term and the contact blocks are always those of ``x1``. Returns the CG iterations, -1
     when the envelope solved it, -2 when its matrix was not positive definite."""
+    c_x, s = newton_matrix(st, sp, x1, wk, fresh)
+    for i in range(x1.shape[0]):
+        for c in range(3):
+            wk.rhs[i, c] = -grad[i, c]
+    coefficients = (c_x, s, st.damping * sp.coef[3], rtol)
+    iterations = stepsolve.solve(
+        st.problem, st.owners, st.op, coefficients, blocks, wk.mass_term, sp.basis, wk.rhs, dx, wk.cg, fresh
+    )
+    if iterations < 0:
+        wk.bending_age[0] = -1  # the envelope's fallback scaled the element matrices
+    return iterations
+
+
+@kernel
+def newton_matrix(st, sp, x1, wk, fresh):
+    """The terms of Newton's matrix at ``x1`` (:func:`direction`): the element matrices in the
+    shell's workspace (new if ``fresh``), ``dV/dx`` and ``wk.mass_term``; returns ``(c_x, s)``
+    (``s`` Pa/m^3 the gas's rank-one weight)."""
     p, c_m, c_x, c_v = st.problem, sp.coef[1], sp.coef[2], sp.coef[3]
     _force_point(sp, x1, wk.xa)
     if fresh:
@@ -146,13 +164,5 @@ def direction(st, sp, x1, grad, blocks, wk, dx, fresh, rtol):
         s = c_x * gas.gas_stiffness(p.model, gas.volume(wk.xa, p.model.triangles))
         gas.volume_gradient(wk.xa, p.model.triangles, p.ws.dvol)
     for i in range(x1.shape[0]):
-        for c in range(3):
-            wk.rhs[i, c] = -grad[i, c]
         wk.mass_term[i] = (c_m + st.damping * c_v) * p.model.mass[i]
-    coefficients = (c_x, s, st.damping * c_v, rtol)
-    iterations = stepsolve.solve(
-        p, st.owners, st.op, coefficients, blocks, wk.mass_term, sp.basis, wk.rhs, dx, wk.cg, fresh
-    )
-    if iterations < 0:
-        wk.bending_age[0] = -1  # the envelope's fallback scaled the element matrices
-    return iterations
+    return c_x, s

@@ -121,3 +121,24 @@ def lumped_masses(mesh: Mesh, density: float, thickness: float) -> NDArray[np.fl
     for m in range(3):
         np.add.at(masses, mesh.triangles[:, m], share)
     return masses
+
+
+def winding_numbers(
+    points: NDArray[np.float64], x: NDArray[np.float64], triangles: NDArray[np.int64], chunk: int = 256
+) -> NDArray[np.float64]:
+    """The winding number (P,) of the closed, outward mesh ``(x, triangles)`` about each of
+    ``points`` (P, 3): the triangles' solid angles seen from the point over 4 pi (1 inside, 0
+    outside), each ``2 atan2(a . (b x c), |a||b||c| + (a.b)|c| + (a.c)|b| + (b.c)|a|)`` with ``a``,
+    ``b``, ``c`` the corners relative to the point (van Oosterom and Strackee 1983); ``chunk``
+    points at a time."""
+    out = np.empty(len(points))
+    corners = [x[triangles[:, m]][None, :, :] for m in range(3)]
+    for start in range(0, len(points), chunk):
+        p = points[start : start + chunk, None, :]
+        a, b, c = (u - p for u in corners)
+        la, lb, lc = (np.linalg.norm(u, axis=2) for u in (a, b, c))
+        ab, ac, bc = (np.sum(u * w, axis=2) for u, w in ((a, b), (a, c), (b, c)))
+        det = np.sum(a * np.cross(b, c), axis=2)
+        angles = 2.0 * np.arctan2(det, la * lb * lc + ab * lc + ac * lb + bc * la)
+        out[start : start + chunk] = angles.sum(axis=1) / (4.0 * np.pi)
+    return out

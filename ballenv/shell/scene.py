@@ -123,7 +123,7 @@ INTEGRATORS = ("generalized_alpha", "backward_euler")
 class Scene:
     """Shells, grounds, the effects acting on them and the numerical method (SI units).
 
-    shells: one or more :class:`Shell` (they do not touch each other yet); grounds: any number of
+    shells: one or more :class:`Shell` (kept apart by a contact barrier); grounds: any number of
     :class:`Ground` half-spaces. gravity: g (m/s^2) along -z in [0, 1000], or a 3-vector (m/s^2).
     damping: c (1/s) in [0, 1e6] of the deformation damping ``F_i = -c m_i (v_i - v_rigid,i)``,
     ``v_rigid`` the mass-weighted least-squares rigid motion (translation plus spin about the
@@ -139,7 +139,9 @@ class Scene:
     each shell's ``E h``; friction_velocity: the slip speed eps_v (m/s) in (0, 10] below which
     Coulomb friction is smoothed (sticking). newton_tol in [1e-14, 1e-2]: Newton stops when every
     vertex's residual acceleration is below ``newton_tol (|g| + R / h^2)``; newton_max_iter in
-    [1, 200]: more and the step is rejected.
+    [1, 200]: more and the step is rejected. self_contact: True or False (default), the barrier
+    also between a vertex and the triangles of its own shell that do not hold it (the same dhat m
+    and kappa N/m; meant for meshes whose edges are longer than dhat).
     """
 
     shells: Sequence[Shell] = field(default_factory=lambda: (Shell(),))
@@ -159,6 +161,7 @@ class Scene:
     friction_velocity: float = 1e-3
     newton_tol: float = 1e-9
     newton_max_iter: int = 30
+    self_contact: bool = False
 
     def __post_init__(self) -> None:
         o, s = "Scene", object.__setattr__
@@ -194,6 +197,8 @@ class Scene:
         )
         s(self, "newton_tol", check_real(o, "newton_tol", self.newton_tol, 1e-14, 1e-2))
         s(self, "newton_max_iter", check_int(o, "newton_max_iter", self.newton_max_iter, 1, 200))
+        if not isinstance(self.self_contact, bool):
+            fail(o, "self_contact", self.self_contact, "True or False")
         for k, shell in enumerate(self.shells):
             if shell.pressure + atm <= 0.0:
                 fail(o, f"shells[{k}].pressure", shell.pressure, f"above -atmospheric_pressure ({atm:g} Pa)")

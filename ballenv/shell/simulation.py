@@ -1,21 +1,22 @@
-"""``simulate(scene, t_end)``: shells under their gas, gravity, damping, grounds and friction,
-advanced by implicit steps (implicit.py), recorded in a :class:`Trajectory` (SI units).
+"""``simulate(scene, t_end)``: shells under their gas, gravity, damping, grounds and friction, advanced
+by implicit steps (implicit.py), recorded in a :class:`Trajectory` (SI units).
 
 Each shell starts from its inflated equilibrium (equilibrium.py) centred at its ``position``, or
-from ``x0``, with the velocity ``velocity + angular_velocity x (x - centre)`` or ``v0``. All
-shells take the same steps. Step control: a step whose Newton iteration fails for any shell is
-rejected (never accepted) and retried with half the step; below ``dt_min`` ``simulate`` raises
-:class:`SimulationError`. With ``adaptive``, the local error estimate of the ring's integrators
-(``ballenv.physics.step.integrator``), ``e_i = c h^2 (a1_i - w a0_i)`` (m; generalized-alpha
-``c = beta - 1/6``, ``w = 1``; backward Euler ``c = 1/2``, ``w = 0``), must have an RMS over each
-shell's vertices of at most ``rtol R``: a larger one rejects the step, and the next step is
-``h min(1.25, max(0.2, 0.9 (rtol R / e)^q))`` (``q`` 1/3 or 1/2), at most ``dt``. Without it,
-steps are ``dt``, and a halved step doubles back after each accepted step. Records are every
-accepted step, or, with ``output_dt``, at its multiples, interpolated inside the steps (cubic
-Hermite positions and their derivative; contact forces linearly), which never changes the steps.
+from ``x0``, with the velocity ``velocity + angular_velocity x (x - centre)`` or ``v0``. All shells
+take the same steps; shells that may touch take them jointly (groups.py, joint.py). Step control: a
+step whose Newton iteration fails for any shell is rejected (never accepted) and retried with half
+the step; below ``dt_min`` ``simulate`` raises :class:`SimulationError`. With ``adaptive``, the
+local error estimate of the ring's integrators (``ballenv.physics.step.integrator``), ``e_i = c h^2
+(a1_i - w a0_i)`` (m; generalized-alpha ``c = beta - 1/6``, ``w = 1``; backward Euler ``c = 1/2``,
+``w = 0``), must have an RMS over each shell's vertices of at most ``rtol R``: a larger one rejects
+the step, and the next step is ``h min(1.25, max(0.2, 0.9 (rtol R / e)^q))`` (``q`` 1/3 or 1/2), at
+most ``dt``. Without it, steps are ``dt``, and a halved step doubles back after each accepted step.
+Records are every accepted step, or, with ``output_dt``, at its multiples, interpolated inside the
+steps (cubic Hermite positions and their derivative; contact forces linearly), which never changes
+the steps.
 Each shell's energy is held to its value at the start (budget.py): an accepted step's small excess
 is taken from its deformation's (or spin's) kinetic energy, a larger one rejects the step. Every
-vertex must start above every ground (``ValueError`` otherwise).
+vertex must start above every ground and outside every other shell (``ValueError`` otherwise).
 """
 
 import time
@@ -25,9 +26,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..physics.step import integrator
-from . import budget, events, ground, implicit, stepdata
+from . import budget, events, ground, groups, implicit, stepdata
 from .equilibrium import equilibrium
 from .gas import gauge_pressure, volume
+from .mesh import icosphere, winding_numbers
 from .model import build_model
 from .scene import Scene
 
@@ -42,7 +44,8 @@ class SimulationError(RuntimeError):
 @dataclass
 class SimulationStats:
     """steps: accepted; rejections; newton_iterations, cg_iterations and envelope_solves (the CG
-    fallback) summed over shells and accepted steps; wall_time (s) of the stepping."""
+    fallback) summed over shells (a joint step of shells in contact counts once) and accepted steps;
+    wall_time (s) of the stepping."""
 
     steps: int = 0
     rejections: int = 0
@@ -55,7 +58,8 @@ class SimulationStats:
 @dataclass
 class Trajectory:
     """t (T,) s; x, v (T, shells, V, 3) m, m/s; contact_force (T, shells, V, 3) N, the grounds'
-    barrier and friction force; pressure (T, shells) Pa gauge; events: ``(t s, shell, kind,
+    barrier and friction force plus the contact barrier's between shells and within one (contact.py);
+    pressure (T, shells) Pa gauge; events: ``(t s, shell, kind,
     centre-of-mass height m)`` with kind "apex", "touchdown" or "liftoff"; stats."""
 
     t: F64
@@ -113,6 +117,7 @@ def initial_states(scene: Scene, x0: ArrayLike | None, v0: ArrayLike | None) -> 
         vs[:] = np.asarray(v0, dtype=np.float64).reshape(shape)
     if not (np.all(np.isfinite(xs)) and np.all(np.isfinite(vs))):
         raise ValueError(f"x0 and v0 must be finite arrays of shape {shape} (m, m/s)")
+    _check_apart(scene, xs, x0 is not None)
     for k, shell in enumerate(scene.shells):
         for g, gr in enumerate(scene.grounds):
             gap = float((xs[k] @ np.array(gr.normal)).min()) - gr.height
@@ -124,6 +129,24 @@ def initial_states(scene: Scene, x0: ArrayLike | None, v0: ArrayLike | None) -> 
                     f"grounds[{g}]; every vertex must start above every ground"
                 )
     return xs, vs
+
+
+def _check_apart(scene: Scene, xs: F64, given: bool) -> None:
+    """``ValueError`` if a vertex of a shell starts inside another shell (winding number above 1/2)."""
+    triangles = icosphere(scene.shells[0].subdivisions).triangles
+    centres = xs.mean(axis=1)
+    radii = np.linalg.norm(xs - centres[:, None, :], axis=2).max(axis=1)
+    for i in range(len(xs)):
+        for j in range(len(xs)):
+            if i == j or np.linalg.norm(centres[i] - centres[j]) > radii[i] + radii[j]:
+                continue
+            if winding_numbers(xs[i], xs[j], triangles).max() > 0.5:
+                name = "x0" if given else f"Scene.shells[{i}].position"
+                value = "given" if given else scene.shells[i].position
+                raise ValueError(
+                    f"{name} = {value} is out of range: shell {i} starts inside shell {j}; "
+                    "shells must start apart"
+                )
 
 
 class Recorder:
@@ -180,9 +203,16 @@ def error_ratio(
 
 
 def try_step(
-    method: implicit.Integrator, steps: list[stepdata.ShellStep], state: tuple[F64, F64, F64], h: float
+    method: implicit.Integrator,
+    steps: list[stepdata.ShellStep],
+    state: tuple[F64, F64, F64],
+    h: float,
+    contacts: groups.Contacts | None = None,
 ) -> list[implicit.StepResult]:
-    """Every shell's step of ``h`` (s), or :class:`implicit.StepFailure`."""
+    """Every shell's step of ``h`` (s), or :class:`implicit.StepFailure`; with ``contacts``, shells
+    that may touch step jointly (groups.py)."""
+    if contacts is not None:
+        return contacts.step(method, state, h)
     x, v, a = state
     return [implicit.step(method, st, x[k], v[k], a[k], h) for k, st in enumerate(steps)]
 
@@ -205,6 +235,9 @@ class Run:
     def __init__(self, scene: Scene, x0: ArrayLike | None, v0: ArrayLike | None, output_dt: float | None):
         self.scene = scene
         self.method, self.steps = build(scene)
+        touching = len(self.steps) > 1 or scene.self_contact
+        dhat = scene.contact_distance
+        self.contacts = groups.Contacts(self.steps, dhat, scene.self_contact) if touching else None
         self.x, self.v = initial_states(scene, x0, v0)
         self.a = np.array(
             [implicit.initial_acceleration(st, self.x[k], self.v[k]) for k, st in enumerate(self.steps)]
@@ -216,15 +249,23 @@ class Run:
         self.events: list[tuple[float, int, str, float]] = []
         self.recorder.add(0.0, self.x, self.v, self.force)
         self.budget = budget.energies(self.steps, self.x, self.v)
+        self.sharing = budget.Sharing(len(self.steps))
 
     def within_budget(self, results: list[implicit.StepResult]) -> bool:
-        """Holds each shell's step end to its energy budget (budget.py), scaling the results'
-        velocities in place; False if the step must be rejected."""
-        for k, r in enumerate(results):
-            held = r.energy <= self.budget[k] or budget.hold(
-                self.steps[k], r.x, r.v, r.energy, self.budget[k]
-            )
-            if not held:
+        """Holds each shell's step end to its energy budget (budget.py; shells stepped jointly
+        share theirs from then on), scaling the results' velocities in place; False if the step
+        must be rejected."""
+        if self.contacts is not None:
+            for group in self.contacts.last_groups:
+                self.sharing.join(group)
+        for members in self.sharing.sets():
+            energy = sum(results[k].energy for k in members)
+            limit = sum(self.budget[k] for k in members)
+            if energy <= limit:
+                continue
+            steps = [self.steps[k] for k in members]
+            xs, vs = [results[k].x for k in members], [results[k].v for k in members]
+            if not budget.hold(steps, xs, vs, energy, limit):
                 return False
         return True
 
@@ -272,7 +313,7 @@ def simulate(
     while t < t_end * (1.0 - 1e-12):
         trial = min(h, t_end - t)
         try:
-            results = try_step(method, run.steps, (run.x, run.v, run.a), trial)
+            results = try_step(method, run.steps, (run.x, run.v, run.a), trial, run.contacts)
         except implicit.StepFailure:
             h = run.reject(t, 0.5 * trial, "the step was halved")
             continue

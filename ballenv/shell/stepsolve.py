@@ -72,19 +72,17 @@ def _envelope_solve(problem, owners, c_x, s, vertex_blocks, rhs, out, z, zero):
 
 
 @kernel
-def solve(problem, owners, op, coefficients, contact_blocks, mass_term, basis, rhs, out, work, assemble):
-    """``out = A^-1 rhs`` (module doc) with the triangles' matrices (unscaled) and ``dV/dx`` in the
+def load(problem, op, coefficients, contact_blocks, mass_term, basis, assemble):
+    """``A`` (module doc) into ``op``, with the triangles' matrices (unscaled) and ``dV/dx`` in the
     workspace of ``problem`` (equilibrium.Problem) and the hinges' part in ``op.hinge_values``
-    (blocks.assemble_hinges), assembled into ``op`` if ``assemble`` (else those assembled before),
+    (blocks.assemble_hinges), assembled if ``assemble`` (else those assembled before),
     ``coefficients = (c_x, s, d, CG's rtol)``, the contact's vertex blocks (V, 3, 3), the diagonal
-    ``mass_term`` (V,) per vertex and the rank-6 ``basis`` (6, V, 3) or (0, V, 3). Returns the CG
-    iterations, -1 when the envelope solved it (the workspace's element matrices are then changed),
-    -2 when that matrix was not positive definite."""
+    ``mass_term`` (V,) per vertex and the rank-6 ``basis`` (6, V, 3) or (0, V, 3)."""
     ws = problem.ws
-    c_x, s, d, rtol = coefficients
+    c_x, s, d, _ = coefficients
     if assemble:
         blocks.assemble_kept(op.pattern, ws.tri_hess, op.hinge_values, c_x, op.values)
-    for v in range(rhs.shape[0]):
+    for v in range(mass_term.shape[0]):
         for a in range(3):
             for b in range(3):
                 op.vertex_blocks[v, a, b] = contact_blocks[v, a, b] + (mass_term[v] if a == b else 0.0)
@@ -93,9 +91,18 @@ def solve(problem, owners, op, coefficients, contact_blocks, mass_term, basis, r
     op.weights[0] = s
     for k in range(basis.shape[0]):
         op.weights[1 + k] = -d
-        for v in range(rhs.shape[0]):
+        for v in range(mass_term.shape[0]):
             for c in range(3):
                 op.vectors[1 + k, v, c] = basis[k, v, c]
+
+
+@kernel
+def solve(problem, owners, op, coefficients, contact_blocks, mass_term, basis, rhs, out, work, assemble):
+    """``out = A^-1 rhs`` (module doc), ``A`` loaded into ``op`` (:func:`load`, the same arguments).
+    Returns the CG iterations, -1 when the envelope solved it (the workspace's element matrices are
+    then changed), -2 when that matrix was not positive definite."""
+    c_x, s, _, rtol = coefficients
+    load(problem, op, coefficients, contact_blocks, mass_term, basis, assemble)
     iterations = cg.pcg(op, problem.free, rhs, out, work, rtol, CG_MAX_ITER)
     if iterations >= 0:
         return iterations

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from ballenv.shell.gas import volume
-from ballenv.shell.mesh import counts, icosphere, lumped_masses, triangle_areas
+from ballenv.shell.mesh import counts, icosphere, lumped_masses, triangle_areas, winding_numbers
 
 
 @pytest.mark.parametrize("k", [0, 1, 2, 3, 4])
@@ -50,3 +50,14 @@ def test_lumped_masses_share_the_skin_mass():
     assert masses.sum() == pytest.approx(1100.0 * 3e-3 * area, rel=1e-12)
     assert area == pytest.approx(4 * np.pi * 0.12**2, rel=6e-3)
     assert masses.min() > 0.5 * masses.mean()
+
+
+def test_the_winding_number_is_one_inside_and_zero_outside():
+    mesh = icosphere(2, 0.5)
+    rng = np.random.default_rng(1)
+    inside = 0.45 * rng.uniform(-1, 1, (50, 3)) / np.sqrt(3)
+    outside = inside / np.linalg.norm(inside, axis=1)[:, None] * 0.6
+    np.testing.assert_allclose(
+        winding_numbers(inside, mesh.vertices, mesh.triangles, chunk=7), 1.0, atol=1e-12
+    )
+    np.testing.assert_allclose(winding_numbers(outside, mesh.vertices, mesh.triangles), 0.0, atol=1e-12)

@@ -173,3 +173,13 @@ def test_two_shells_step_together_each_as_alone_and_bad_arguments_name_themselve
         simulate(Scene(shells=[a]), t_end=-1)
     with pytest.raises(ValueError, match=r"x0 and v0 must be finite arrays of shape \(1, 42, 3\)"):
         simulate(Scene(shells=[a]), t_end=0.1, v0=np.full((1, 42, 3), np.nan))
+
+
+def test_a_shell_starting_through_a_ground_or_inside_another_names_itself():
+    with pytest.raises(
+        ValueError, match=r"Scene.shells\[0\].position = \(0.0, 0.0, 0.1\) .* through grounds\[0\]"
+    ):
+        simulate(Scene(shells=[Shell(subdivisions=1, position=(0, 0, 0.1))], grounds=[Ground()]), 1e-3)
+    pair = [Shell(subdivisions=1, position=(0, 0, 1)), Shell(subdivisions=1, position=(0.2, 0, 1))]
+    with pytest.raises(ValueError, match=r"shell 0 starts inside shell 1; shells must start apart"):
+        simulate(Scene(shells=pair, gravity=0.0), 1e-3)
