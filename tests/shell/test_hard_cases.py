@@ -78,11 +78,8 @@ def audit(scene, t_end, x0=None):
     return traj
 
 
-SLOW = {"half_deflated"}  # a joint self-contact step every step: about a minute a run
-
-
 @pytest.mark.parametrize("integrator", INTEGRATORS)
-@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.slow) if n in SLOW else n for n in CASES])
+@pytest.mark.parametrize("name", list(CASES))
 def test_hard_case_is_stable(name, integrator):
     scene, t_end, x0 = CASES[name]
     traj = audit(replace(scene, integrator=integrator), t_end, x0)
