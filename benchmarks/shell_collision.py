@@ -36,9 +36,11 @@ import time  # noqa: E402
 import numpy as np  # noqa: E402
 
 from ballenv.files import write_text  # noqa: E402
-from ballenv.shell import Scene, Shell, broadphase, contact, implicit, simulate  # noqa: E402
-from ballenv.shell.jointdata import make_joint  # noqa: E402
+from ballenv.shell import Scene, Shell, simulate  # noqa: E402
 from ballenv.shell.simulation import build  # noqa: E402
+from ballenv.shell.step import implicit  # noqa: E402
+from ballenv.shell.step.jointdata import make_joint  # noqa: E402
+from ballenv.shell.touch import broadphase, contact  # noqa: E402
 
 RESULTS = pathlib.Path(__file__).parent / "results"
 ROOT = pathlib.Path(__file__).resolve().parents[1]

@@ -1,7 +1,7 @@
 """Options for the Newton linear solve of the 3-D shell, measured on the same systems: the envelope
 Cholesky after reverse Cuthill-McKee with the gas's rank-one term by Sherman-Morrison (kept,
-ballenv/shell/envelope.py), Jacobi-preconditioned CG on the element matrices assembled as a
-block-sparse matrix (ballenv/shell/cg.py, blocks.py; the assembly is in its time), and a dense LU
+ballenv/shell/solve/envelope.py), Jacobi-preconditioned CG on the element matrices assembled as a
+block-sparse matrix (ballenv/shell/solve/cg.py, blocks.py; the assembly is in its time), and a dense LU
 (LAPACK through NumPy's np.linalg.solve) as the reference.
 
     python benchmarks/shell_linear_solve.py     # writes benchmarks/results/shell_linear_solve.md
@@ -9,7 +9,7 @@ block-sparse matrix (ballenv/shell/cg.py, blocks.py; the assembly is in its time
 Systems: the default ball (Shell(): R = 0.12 m, E = 5 MPa, nu = 0.45, h = 3 mm, p = 55 kPa,
 isothermal gas) at its inflated equilibrium, on icospheres of 162, 642 and 2562 vertices.
 "static": the Hessian K with the six components of the determinate support fixed (what
-ballenv.shell.equilibrium solves); "dynamic": M / dt^2 + K with dt = 1e-3 s and 1e-4 s (what an
+ballenv.shell.rest.equilibrium solves); "dynamic": M / dt^2 + K with dt = 1e-3 s and 1e-4 s (what an
 implicit step solves). CG stops at a residual of 1e-8 of the right-hand side. Times are medians of
 repeated runs, numba warm, OPENBLAS_NUM_THREADS=1; the ratios divide by the dense solve's time in the
 same process.
@@ -29,10 +29,12 @@ import time  # noqa: E402
 import numpy as np  # noqa: E402
 
 from ballenv.files import write_text  # noqa: E402
-from ballenv.shell import Shell, blocks, cg, envelope, equilibrium, potential  # noqa: E402
-from ballenv.shell.equilibrium import determinate_support  # noqa: E402
-from ballenv.shell.model import build_model, build_workspace  # noqa: E402
-from ballenv.shell.modes import element_dofs  # noqa: E402
+from ballenv.shell import Shell, equilibrium  # noqa: E402
+from ballenv.shell.rest.equilibrium import determinate_support  # noqa: E402
+from ballenv.shell.rest.modes import element_dofs  # noqa: E402
+from ballenv.shell.skin import potential  # noqa: E402
+from ballenv.shell.skin.model import build_model, build_workspace  # noqa: E402
+from ballenv.shell.solve import blocks, cg, envelope  # noqa: E402
 
 RESULTS = pathlib.Path(__file__).parent / "results"
 ROOT = pathlib.Path(__file__).resolve().parents[1]

@@ -18,6 +18,10 @@ PHYSICS_LAYERS = (
     "base", "model", "scene", "effects", "ground", "walls", "step", "build", "trajectory",
     "simulation", "presets", "__init__",
 )  # fmt: skip
+# the 3-D ball's layers, lowest first, in the same way
+SHELL_LAYERS = (
+    "scene", "skin", "solve", "touch", "rest", "step", "simulation", "presets", "balls", "__init__",
+)  # fmt: skip
 # the package's layers, lowest first (a top-level module or sub-package of ballenv, or agents)
 PACKAGE_LAYERS = (
     ("ballenv.extras", "ballenv.files", "ballenv.draw", "ballenv.video"),
@@ -115,6 +119,12 @@ def physics_layer(module):
     return PHYSICS_LAYERS.index(rest[0])
 
 
+def shell_layer(module):
+    """Rank of a ``ballenv.shell`` module in ``SHELL_LAYERS``."""
+    rest = module.split(".")[2:] or ["__init__"]
+    return SHELL_LAYERS.index(rest[0])
+
+
 def package_layer(module):
     """Rank of a module in ``PACKAGE_LAYERS`` (by its longest listed prefix)."""
     best = None
@@ -134,6 +144,9 @@ def climbs(graph):
             if a.startswith("ballenv.physics") and b.startswith("ballenv.physics"):
                 if physics_layer(b) > physics_layer(a):
                     out.append((a, b))
+            elif a.startswith("ballenv.shell") and b.startswith("ballenv.shell"):
+                if shell_layer(b) > shell_layer(a):
+                    out.append((a, b))
             elif package_layer(b) > package_layer(a):
                 out.append((a, b))
     return out
@@ -143,6 +156,7 @@ def test_the_walk_sees_every_module_and_the_imports_hidden_in_functions():
     assert len(MODULES) > 70
     graph = internal_graph()
     assert "ballenv.physics.step.newton" in graph["ballenv.physics.step.stepper"]
+    assert "ballenv.shell.skin.damping" in graph["ballenv.shell.step.implicit"]
     # the env imports its renderer inside render() (pygame and Pillow load only when drawing)
     assert "ballenv.envs.render" in graph["ballenv.envs.inflated_ball"]
 

@@ -1,26 +1,28 @@
 """The 3-D inflated ball: a discrete-shell simulator (pure numerics: NumPy + numba).
 
-An icosphere mesh (mesh.py); St. Venant-Kirchhoff membrane triangles (membrane.py); discrete-shell
-hinge bending (bending.py); the enclosed gas (gas.py); their total potential (potential.py); the
-envelope Cholesky of its Hessian (envelope.py), its block-sparse assembly (blocks.py) and
-block-Jacobi-preconditioned CG (cg.py); static equilibrium (equilibrium.py) and linear vibration
-modes (modes.py). The dynamics: the validated descriptions ``Shell``, ``Ground``, ``Scene``
-(scene.py); grounds' barriers (ground.py), lagged Coulomb friction (friction.py) and damping of the
-deformation only (damping.py); the implicit step, backward Euler or generalized-alpha
-(implicit.py), its incremental potential (increment.py), its records (stepdata.py) and its linear
-solve (stepsolve.py); contact between shells and within one: distances (distance.py), the barrier
-and its collision detection (contact.py, projection.py), the broad phase (broadphase.py) and the
-joint step of shells that may touch (groups.py, joint.py, jointdata.py, jointcg.py); the energy
-budget (budget.py); events (events.py); ``simulate`` and ``Trajectory`` (simulation.py); fidelity
-presets (presets.py); regulation balls and their drop tests (balls.py). SI units.
+The skin (skin/): an icosphere mesh (mesh.py); St. Venant-Kirchhoff membrane triangles
+(membrane.py); discrete-shell hinge bending (bending.py); the enclosed gas (gas.py); their total
+potential (potential.py); damping of the deformation only (damping.py); the model records (model.py).
+The linear algebra (solve/): the envelope Cholesky (envelope.py), the block-sparse assembly
+(blocks.py), block-Jacobi-preconditioned CG (cg.py, jointcg.py) and an implicit step's linear solve
+(stepsolve.py). At rest (rest/): static equilibrium (equilibrium.py) and linear vibration modes
+(modes.py). What the shell touches (touch/): grounds' barriers (ground.py), lagged Coulomb friction
+(friction.py), distances (distance.py), the barrier between shells and within one with its collision
+detection (contact.py, projection.py) and the broad phase (broadphase.py). The time step (step/): the
+implicit step, backward Euler or generalized-alpha (implicit.py), its incremental potential
+(increment.py) and records (stepdata.py); the joint step of shells that may touch (groups.py,
+joint.py, jointdata.py); the energy budget (budget.py); events (events.py). At the top: the validated
+descriptions ``Shell``, ``Ground``, ``Scene`` (scene.py); ``simulate`` and ``Trajectory``
+(simulation.py); fidelity presets (presets.py); regulation balls and their drop tests (balls.py). SI
+units.
 """
 
 from ..physics.base.compile_notice import install as _install_compile_notice
-from .equilibrium import Equilibrium, EquilibriumError, equilibrium
-from .mesh import Mesh, icosphere
-from .modes import Modes, modes
+from .rest.equilibrium import Equilibrium, EquilibriumError, equilibrium
+from .rest.modes import Modes, modes
 from .scene import Ground, Scene, Shell
 from .simulation import SimulationError, SimulationStats, Trajectory, simulate
+from .skin.mesh import Mesh, icosphere
 
 __all__ = [
     "Equilibrium",

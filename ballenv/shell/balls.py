@@ -50,10 +50,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from .gas import volume
-from .mesh import icosphere, lumped_masses, triangle_areas
 from .scene import ATMOSPHERIC_PRESSURE, Ground, Scene, Shell
 from .simulation import Trajectory, simulate
+from .skin.gas import volume
+from .skin.mesh import icosphere, lumped_masses, triangle_areas
 
 G = 9.81  # m/s^2
 PSI = 6894.757  # Pa

@@ -26,12 +26,13 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..physics.step import integrator
-from . import budget, events, ground, groups, implicit, stepdata
-from .equilibrium import equilibrium
-from .gas import gauge_pressure, volume
-from .mesh import icosphere, winding_numbers
-from .model import build_model
+from .rest.equilibrium import equilibrium
 from .scene import Scene
+from .skin.gas import gauge_pressure, volume
+from .skin.mesh import icosphere, winding_numbers
+from .skin.model import build_model
+from .step import budget, events, groups, implicit, stepdata
+from .touch import ground
 
 F64 = NDArray[np.float64]
 SHRINK = 0.2  # smallest factor of an adaptive step's change

@@ -2,9 +2,9 @@
 
 import numpy as np
 
-from ballenv.shell.model import build_model, build_workspace
-from ballenv.shell.modes import element_dofs
+from ballenv.shell.rest.modes import element_dofs
 from ballenv.shell.scene import Shell
+from ballenv.shell.skin.model import build_model, build_workspace
 
 
 def small_model(subdivisions=1, pressure=1e4, gas_exponent=1.4, **kwargs):

@@ -1,11 +1,11 @@
 """Independent geometric checks of intersection-freeness for the contact tests (NumPy, brute
-force): the generalized winding number of points about a closed mesh (ballenv.shell.mesh, tested
-in test_mesh.py), segment-triangle crossings and point-triangle distances (by the plane and the
+force): the generalized winding number of points about a closed mesh (ballenv.shell.skin.mesh, tested
+in skin/test_mesh.py), segment-triangle crossings and point-triangle distances (by the plane and the
 three edges, not by feature regions)."""
 
 import numpy as np
 
-from ballenv.shell.mesh import winding_numbers
+from ballenv.shell.skin.mesh import winding_numbers
 
 
 def edges_of(triangles):

@@ -17,10 +17,10 @@ import numpy as np
 import pytest
 
 from ballenv.shell import Ground, Scene, Shell, simulate
-from ballenv.shell.gas import volume
-from ballenv.shell.implicit import total_energy
-from ballenv.shell.model import build_model
 from ballenv.shell.simulation import build
+from ballenv.shell.skin.gas import volume
+from ballenv.shell.skin.model import build_model
+from ballenv.shell.step.implicit import total_energy
 
 from .meshcheck import check_apart, check_self
 

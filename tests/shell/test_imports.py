@@ -20,6 +20,6 @@ def imported_roots(path):
     return roots
 
 
-@pytest.mark.parametrize("path", sorted(SHELL.glob("*.py")), ids=lambda p: p.name)
+@pytest.mark.parametrize("path", sorted(SHELL.rglob("*.py")), ids=lambda p: p.relative_to(SHELL).as_posix())
 def test_the_shell_imports_only_numerics(path):
     assert not imported_roots(path) & FORBIDDEN

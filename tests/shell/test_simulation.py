@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from ballenv.shell import Ground, Scene, Shell, simulate
-from ballenv.shell.model import build_model
+from ballenv.shell.skin.model import build_model
 
 G = 9.81
 
