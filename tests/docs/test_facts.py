@@ -187,6 +187,14 @@ FACTS = {
         r"\| env steps per second, [^|]*\| ([\d,]+) \|",
         lambda hooks: results_cell(hooks, "env_throughput.md", ("fast", "pressure"), "scripted policy"),
     ),
+    "3-D ball's speed": (
+        "README.md",
+        r"\| the 3-D ball [^|]*\| ([\d.]+)x; (-?[\d.]+ %) \|",
+        lambda hooks: [
+            results_cell(hooks, "shell_drop.md", ("162", "preset fast"), "x real time"),
+            results_cell(hooks, "shell_drop.md", ("162", "preset fast"), "first-apex error"),
+        ],
+    ),
     "against PyElastica": (
         "README.md",
         r"\| a 1-s drop within 1 % [^|]*\| ([\d.]+) ms; ([\d.]+)x \|",
