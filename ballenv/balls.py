@@ -46,33 +46,12 @@ from ballenv.physics import Ground, Ring, Scene, simulate
 from ballenv.physics.base.ring import inflated_radius, rest_edge_length, total_mass
 
 from .physics.presets import with_fidelity
+from .rules import FIBA_DROP, FIFA_DROP, ITF_DROP, DropTest
 
 P_ATM = 101325.0  # Pa
 G = 9.81  # m/s^2
 PSI = 6894.757  # Pa
 PEAK_WINDOW = 5e-4  # s: the ground reaction's peak is its mean over windows this long
-
-
-@dataclass(frozen=True)
-class DropTest:
-    """A rule's drop test: the ball released at rest onto a rigid floor, its rebound measured.
-
-    Attributes:
-        drop_height: height (m) of the ball's bottom above the floor at release.
-        rebound: the rule's range (m) of the rebound height.
-        measured_to: the point of the ball the rebound height is measured to, "bottom" or "top".
-        rule: where the test is stated.
-    """
-
-    drop_height: float
-    rebound: tuple[float, float]
-    measured_to: str
-    rule: str
-
-    @property
-    def target(self) -> float:
-        """The middle of the rule's range (m): what the calibration aims at."""
-        return 0.5 * (self.rebound[0] + self.rebound[1])
 
 
 @dataclass(frozen=True)
@@ -218,15 +197,10 @@ FIBA = (
     "FIBA Official Basketball Rules 2020, Basketball Equipment, 2 (size 7: circumference 749-780 mm,"
     " mass 567-650 g; the pressure is the one that passes the drop test)"
 )
-FIBA_DROP = DropTest(1.8, (1.2, 1.4), "top", "FIBA Official Basketball Rules 2020, Basketball Equipment, 2")
 ITF = "ITF Rules of Tennis, Appendix I (type 2: diameter 6.54-6.86 cm, mass 56.0-59.4 g)"
-ITF_DROP = DropTest(2.54, (1.35, 1.47), "bottom", "ITF Rules of Tennis, Appendix I (onto concrete)")
 FIFA = (
     "FIFA Quality Programme for Footballs, FIFA Quality Pro (circumference 68.5-69.5 cm, mass"
     " 420-445 g, tested at 0.8 bar)"
-)
-FIFA_DROP = DropTest(
-    2.0, (1.35, 1.55), "bottom", "FIFA Quality Programme for Footballs (onto a steel plate, 20 C)"
 )
 FIVB = "FIVB Official Volleyball Rules, 3.1 (circumference 65-67 cm, mass 260-280 g, 0.300-0.325 kgf/cm^2)"
 

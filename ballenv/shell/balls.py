@@ -50,6 +50,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from ..rules import FIBA_DROP, FIFA_DROP, ITF_DROP, DropTest
 from .scene import ATMOSPHERIC_PRESSURE, Ground, Scene, Shell
 from .simulation import Trajectory, simulate
 from .skin.gas import volume
@@ -76,26 +77,6 @@ class Material:
     damping: dict[int, float]
     fitted_on: str
     source: str
-
-
-@dataclass(frozen=True)
-class DropTest:
-    """A rule's drop test: the ball released at rest onto a rigid floor, its rebound measured.
-
-    drop_height: height (m) of the ball's bottom at release; rebound: the rule's range (m);
-    measured_to: "bottom" or "top", the point of the ball the rebound height is measured to;
-    rule: where the test is stated.
-    """
-
-    drop_height: float
-    rebound: tuple[float, float]
-    measured_to: str
-    rule: str
-
-    @property
-    def target(self) -> float:
-        """The middle of the rule's range (m): what the fit aims at."""
-        return 0.5 * (self.rebound[0] + self.rebound[1])
 
 
 @dataclass(frozen=True)
@@ -304,27 +285,15 @@ FIBA = (
     "FIBA Official Basketball Rules 2020, Basketball Equipment, 2 (size 7: circumference 749-780 mm,"
     " mass 567-650 g; no pressure: the one that passes the drop test)"
 )
-FIBA_DROP = DropTest(
-    1.8, (1.2, 1.4), "top", "FIBA Official Basketball Rules 2020, Basketball Equipment, 2 (bottom"
-    " released at about 1.8 m, rebound 1.2-1.4 m measured to the top of the ball)"
-)  # fmt: skip
 FIFA = (
     "FIFA Quality Programme for Footballs, FIFA Quality Pro (circumference 68.5-69.5 cm, mass"
     " 420-445 g, tested at 0.8 bar gauge)"
 )
-FIFA_DROP = DropTest(
-    2.0, (1.35, 1.55), "bottom", "FIFA Quality Programme for Footballs, FIFA Quality Pro (dropped"
-    " 10 times from 2 m onto a steel plate at 20 C, rebound 135-155 cm)"
-)  # fmt: skip
 ITF = (
     "ITF Rules of Tennis, Appendix I (type 2: diameter 6.54-6.86 cm, mass 56.0-59.4 g; no pressure:"
     " a pressurised ball holds about 12 psi above the atmosphere, as University of Illinois Physics"
     " Van's Tennis ball facts states; a maker, Artengo, states about 0.8 bar)"
 )
-ITF_DROP = DropTest(
-    2.54, (1.35, 1.47), "bottom", "ITF Rules of Tennis, Appendix I (dropped from 254 cm onto"
-    " concrete, rebound 135-147 cm)"
-)  # fmt: skip
 FIVB = (
     "FIVB Official Volleyball Rules, 3.1 (circumference 65-67 cm, mass 260-280 g, inside pressure"
     " 0.300-0.325 kg/cm^2; no drop test)"
