@@ -10,9 +10,9 @@ shows it the cheapest for a given first-apex error) with adaptive steps at most 
 =========  ========  ======  =====  ==========  ===========  ===========================
 preset     vertices  k       rtol   largest dt  newton_tol   first-apex error (bound)
 =========  ========  ======  =====  ==========  ===========  ===========================
-fast       162       2       1e-3   0.01 s      1e-7         1.5 %
-balanced   642       3       3e-4   0.004 s     1e-9         0.75 %
-accurate   2562      4       1e-4   0.002 s     1e-10        0.5 %
+fast       162       2       1e-3   0.01 s      1e-4         1.5 %
+balanced   642       3       3e-4   0.004 s     1e-6         0.75 %
+accurate   2562      4       1e-4   0.002 s     1e-7         0.5 %
 =========  ========  ======  =====  ==========  ===========  ===========================
 
 The bound is on the error of the step control: the first apex of each ball of
@@ -31,9 +31,9 @@ from .scene import Scene
 PRESET_RHO_INFINITY = 0.0
 
 FIDELITY_PRESETS: dict[str, dict[str, Any]] = {
-    "fast": {"subdivisions": 2, "rtol": 1e-3, "dt": 1e-2, "newton_tol": 1e-7, "apex_error_bound": 0.015},
-    "balanced": {"subdivisions": 3, "rtol": 3e-4, "dt": 4e-3, "newton_tol": 1e-9, "apex_error_bound": 0.0075},
-    "accurate": {"subdivisions": 4, "rtol": 1e-4, "dt": 2e-3, "newton_tol": 1e-10, "apex_error_bound": 0.005},
+    "fast": {"subdivisions": 2, "rtol": 1e-3, "dt": 1e-2, "newton_tol": 1e-4, "apex_error_bound": 0.015},
+    "balanced": {"subdivisions": 3, "rtol": 3e-4, "dt": 4e-3, "newton_tol": 1e-6, "apex_error_bound": 0.0075},
+    "accurate": {"subdivisions": 4, "rtol": 1e-4, "dt": 2e-3, "newton_tol": 1e-7, "apex_error_bound": 0.005},
 }
 
 

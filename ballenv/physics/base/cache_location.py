@@ -9,8 +9,9 @@ same code share the folder, not the kernels: numba names them by the source file
 folder sits under the first writable of ``NUMBA_CACHE_DIR`` (if set),
 ``$XDG_CACHE_HOME/ballenv/numba`` (by default ``~/.cache/ballenv/numba``, 0700) and a private folder
 in the system's temporary directory (said once); with none writable, every run compiles (said once).
-Of the folders under the same parent, the ``KEEP`` most recently used are kept and older ones
-removed.
+Of the folders under the same parent, the ``KEEP`` most recently used are kept, and older ones
+removed once unused for ``IDLE`` seconds (a process of another version may still be running
+from a folder it opened earlier: its kernels are never deleted under it).
 
 A read-only install can ship its cache: build it with ``NUMBA_CACHE_DIR`` pointing into the install
 (run the kernels once, e.g. the test suite), make it read-only, and run with the same setting. numba
@@ -26,6 +27,7 @@ import re
 import shutil
 import sys
 import tempfile
+import time
 from collections.abc import Callable
 
 import numba
@@ -37,6 +39,7 @@ from .compile_notice import log_info
 PACKAGE = pathlib.Path(__file__).resolve().parents[2]  # ballenv/
 KERNEL_PACKAGES = ("physics", "envs", "shell")  # where kernels and the constants they freeze are defined
 KEEP = 4  # cache folders of other sources kept under one parent
+IDLE = 86400.0  # s: a folder beyond those is removed once unused for this long
 KEY = re.compile(r"[0-9a-f]{16}")
 MOVED = "no writable cache folder in %s: numba's cache of the simulator goes to %s"
 SEEDED = "numba's cache of the simulator in %s is read-only: its kernels are copied to %s"
@@ -117,15 +120,18 @@ def choose(key: str, is_writable: Callable[[pathlib.Path], bool] = writable) -> 
     return None
 
 
-def prune(parent: pathlib.Path, current: pathlib.Path) -> None:
-    """Remove the cache folders under ``parent`` beyond the ``KEEP`` most recently used."""
+def prune(parent: pathlib.Path, current: pathlib.Path, now: float | None = None) -> None:
+    """Remove the cache folders under ``parent`` beyond the ``KEEP`` most recently used that have
+    not been used for ``IDLE`` seconds before ``now`` (s since the epoch; default: the clock)."""
+    now = time.time() if now is None else now
     try:
         others = [p for p in parent.iterdir() if p != current and p.is_dir() and KEY.fullmatch(p.name)]
+        used = sorted(((p.stat().st_mtime, p) for p in others), reverse=True)
     except OSError:
         return
-    others.sort(key=lambda p: p.stat().st_mtime, reverse=True)
-    for old in others[KEEP:]:
-        shutil.rmtree(old, ignore_errors=True)
+    for mtime, old in used[KEEP:]:
+        if now - mtime > IDLE:
+            shutil.rmtree(old, ignore_errors=True)
 
 
 def apply() -> bool:

@@ -145,12 +145,20 @@ def _second_derivatives(abc, la, det, cr, hx, hy):
 
 
 @kernel
-def bending_energy(x, hinge, theta0, weight, kb, abc):
-    """Bending energy (J) of all hinges; ``abc`` (3, 3) scratch."""
+def bending_energy(x, hinge, theta0, weight, kb):
+    """Bending energy (J) of all hinges."""
     total = 0.0
     for k in range(hinge.shape[0]):
-        _edge_vectors(x, hinge, k, abc)
-        theta = _angle(abc)[0]
+        i, j, m, n = hinge[k, 0], hinge[k, 1], hinge[k, 2], hinge[k, 3]
+        a0, a1, a2 = x[j, 0] - x[i, 0], x[j, 1] - x[i, 1], x[j, 2] - x[i, 2]
+        b0, b1, b2 = x[m, 0] - x[i, 0], x[m, 1] - x[i, 1], x[m, 2] - x[i, 2]
+        c0, c1, c2 = x[n, 0] - x[i, 0], x[n, 1] - x[i, 1], x[n, 2] - x[i, 2]
+        aa = a0 * a0 + a1 * a1 + a2 * a2
+        big_x = (a0 * b0 + a1 * b1 + a2 * b2) * (a0 * c0 + a1 * c1 + a2 * c2) - aa * (
+            b0 * c0 + b1 * c1 + b2 * c2
+        )
+        det = a0 * (b1 * c2 - b2 * c1) + a1 * (b2 * c0 - b0 * c2) + a2 * (b0 * c1 - b1 * c0)
+        theta = np.arctan2(-np.sqrt(aa) * det, big_x)
         total += kb * weight[k] * (theta - theta0[k]) ** 2
     return total
 

@@ -19,7 +19,7 @@ def energy(model, ws, x, loads):
     """Pi(x) (J)."""
     m = model
     total = membrane_energy(x, m.triangles, m.beta, m.area, m.lam, m.mu, m.thickness, ws.scratch.f)
-    total += bending_energy(x, m.hinges, m.theta0, m.weight, m.kb, ws.scratch.abc)
+    total += bending_energy(x, m.hinges, m.theta0, m.weight, m.kb)
     total += gas_energy(m, volume(x, m.triangles))
     for i in range(x.shape[0]):
         for c in range(3):

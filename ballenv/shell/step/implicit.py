@@ -50,7 +50,7 @@ FRICTION_LAGS = 3  # updates of the lagged normal forces within a step
 LAG_TOL = 1e-3  # their change (relative to the weight) that asks for another
 FORCING = 0.25  # a Newton direction's linear residual against the force Newton's test asks for
 CG_RTOL_MIN = 1e-8  # its bounds relative to the gradient (stepsolve.py)
-CG_RTOL_MAX = 1e-5
+CG_RTOL_MAX = 1e-1
 LAG_CONTRACTION = 0.1  # a Newton residual above this fraction of the last asks for new element matrices
 FAILURES = {
     1: "a non-finite gradient",
@@ -149,9 +149,11 @@ def forcing(grad, force_goal):
 
 
 @kernel
-def newton(method, st, sp, wk):
+def newton(method, st, sp, wk, matrices):
     """Newton's iteration from ``wk.x``: ``(status, iterations, CG iterations, envelope solves)``
-    (status 0: converged, else a key of ``FAILURES``)."""
+    (status 0: converged, else a key of ``FAILURES``). The skin's element matrices are evaluated
+    at its first iterate if ``matrices`` (else those of an earlier Newton iteration of the step are
+    kept), and again when an iteration contracted the residual too little."""
     h = sp.coef[0]
     goal = method.solver.newton_tol * (st.gravity + st.radius / (h * h))
     mass = st.problem.model.mass
@@ -171,7 +173,7 @@ def newton(method, st, sp, wk):
         if iteration == method.solver.newton_max_iter:
             break
         # the envelope's fallback changes the element matrices: new ones after it
-        fresh = iteration == 0 or envelope_solves > 0 or residual > LAG_CONTRACTION * previous
+        fresh = (iteration == 0 and matrices) or envelope_solves > 0 or residual > LAG_CONTRACTION * previous
         previous = residual
         rtol = forcing(wk.grad, goal * lightest)
         iterations = increment.direction(st, sp, wk.x, wk.grad, wk.blocks, wk, wk.dx, fresh, rtol)
@@ -216,7 +218,8 @@ def step_kernel(method, st, x0, v0, a0, h):
         frictional |= st.mu[g] > 0.0
     newton_total = cg_total = envelope_total = 0
     for lag in range(FRICTION_LAGS + 1):
-        status, iterations, cg_iterations, envelope_solves = newton(method, st, sp, wk)
+        matrices = lag == 0 or envelope_total > 0  # a later round starts from the last iterate's
+        status, iterations, cg_iterations, envelope_solves = newton(method, st, sp, wk, matrices)
         newton_total += iterations
         cg_total += cg_iterations
         envelope_total += envelope_solves
@@ -297,11 +300,12 @@ def incremental_gradient(method: Integrator, st: ShellStep, sp: Start, x1: F64) 
 
 
 def direction(st: ShellStep, sp: Start, x1: F64, grad: F64, blocks: F64) -> tuple[F64, int]:
-    """Newton's correction (m) at ``x1`` and the CG iterations (-1: the envelope solved it)."""
+    """Newton's correction (m) at ``x1``, solved to CG's tightest tolerance (``CG_RTOL_MIN`` of the
+    gradient), and the CG iterations (-1: the envelope solved it)."""
     dx = np.zeros_like(x1)
     x1 = np.ascontiguousarray(x1)
     st.work.bending_age[0] = -1
-    iterations = increment.direction(st, sp, x1, grad, blocks, st.work, dx, True, CG_RTOL_MAX)
+    iterations = increment.direction(st, sp, x1, grad, blocks, st.work, dx, True, CG_RTOL_MIN)
     if iterations == -2:
         raise StepFailure(FAILURES[3])
     return dx, int(iterations)

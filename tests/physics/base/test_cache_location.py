@@ -75,6 +75,21 @@ def test_old_cache_folders_beyond_the_most_recent_few_are_removed(homes):
     assert kept == sorted([*newest, "fedcba9876543210", "not-a-key"])
 
 
+def test_a_cache_folder_in_recent_use_is_never_removed(homes):
+    """Another version's process may still be loading and writing kernels in its folder."""
+    parent = homes / "home-cache" / "ballenv" / "numba"
+    parent.mkdir(parents=True)
+    now = 1e9
+    for k in range(7):
+        folder = parent / f"{k:016x}"
+        folder.mkdir()
+        age = cache_location.IDLE * (2.0 if k < 2 else 0.5)  # 0 and 1 idle for two days
+        os.utime(folder, (now - age - k, now - age - k))
+    cache_location.prune(parent, parent / "fedcba9876543210", now)
+    kept = sorted(p.name for p in parent.iterdir())
+    assert kept == [f"{k:016x}" for k in range(2, 7)]
+
+
 AREA = """
 import numpy as np
 from ballenv.physics.base.geometry import polygon_area

@@ -12,7 +12,7 @@ from ..conftest import assemble_dense, central_gradient, central_jacobian, relat
 
 def energy(model, x, kb=None):
     kb = model.kb if kb is None else kb
-    return bending_energy(x, model.hinges, model.theta0, model.weight, kb, np.zeros((3, 3)))
+    return bending_energy(x, model.hinges, model.theta0, model.weight, kb)
 
 
 def gradient(model, ws, x):
