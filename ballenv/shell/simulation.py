@@ -65,8 +65,9 @@ class Trajectory:
     barrier and friction force plus the contact barrier's between shells and within one (contact.py);
     pressure (T, shells) Pa gauge; events: ``(t s, shell, kind,
     centre-of-mass height m)`` with kind "apex", "touchdown" or "liftoff"; stats; boundary_work
-    (T, shells) J: the work the moving grounds have done on each shell since t = 0 (budget.py; 0 on
-    fixed grounds)."""
+    (T, shells) J: the work credited to each shell's energy budget for the moving grounds since
+    t = 0 (budget.boundary_work: an upper bound of their work, the step dissipating the rest; 0 on
+    fixed grounds), so that its energy never exceeds its start energy plus this."""
 
     t: F64
     x: F64

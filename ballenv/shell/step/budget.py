@@ -74,7 +74,11 @@ def boundary_work(st: ShellStep, heights0: F64, x1: F64, h: float) -> float:
     planes: the first term (the barriers' energy ``B``, ground.py) is what that move did; the
     second, the work of friction's force ``F = -grad D`` (N, at ``x1``, friction.py) through the
     surfaces' slides ``s_g`` (m). A moving ground's power on a vertex, ``f . v = f . w + f . (v - w)``,
-    is its work; the rest (friction on the slip) only dissipates. 0 on fixed grounds."""
+    is its work; the rest (friction on the slip) only dissipates. The first term bounds what a
+    dissipative step can gain from the move, so a legitimate gain is never clipped; it exceeds the
+    work ``lambda n . (d(t1) - d(t0))`` by about ``k (n . (d(t1) - d(t0)))^2 / 2`` (``k`` the
+    barrier's stiffness, N/m), which the step dissipates: a ball carried up by a plate is credited
+    a few times the work of lifting it. 0 on fixed grounds."""
     sp, n = st.start, st.normals
     lift = ground.barrier_energy(sp.x0, n, st.heights, st.dhat, st.kappa)
     lift -= ground.barrier_energy(sp.x0, n, heights0, st.dhat, st.kappa)
