@@ -3,7 +3,8 @@ with it; a ball dropped on a conveyor belt slips at mu g until it rolls with the
 speed from its angular momentum about the contact point); a ball on a vibrating table stays on it
 while the table's peak acceleration is below g and bounces off (at the phase where the table's
 deceleration first exceeds g) well above it, never holding more energy than it had plus the
-table's work; fixed grounds step as before."""
+table's work; fixed grounds step as before (and so does a frictionless belt, which moves only
+along its plane)."""
 
 import math
 
@@ -120,6 +121,17 @@ def test_a_ball_on_a_vibrating_table_leaves_it_only_when_the_table_outpulls_grav
         assert leaves < liftoffs[0] < leaves + 0.125 / frequency
     assert energy_excess(traj, amplitude, omega) <= 1e-9
     assert traj.boundary_work[-1, 0] > 0.0
+
+
+def test_a_frictionless_belt_steps_bit_for_bit_as_a_fixed_floor(resting):
+    x0, _ = resting
+    runs = [
+        simulate(Scene(grounds=[floor], rtol=1e-3), t_end=0.05, x0=x0[None], v0=np.full((1, len(x0), 3), 0.1))
+        for floor in (Ground(), Ground(velocity=(1.0, 0.0, 0.0)))
+    ]
+    assert np.array_equal(runs[0].t, runs[1].t) and np.array_equal(runs[0].x, runs[1].x)
+    assert np.array_equal(runs[0].contact_force, runs[1].contact_force)
+    assert np.all(runs[1].boundary_work == 0.0)
 
 
 def test_fixed_grounds_do_no_work_and_a_start_through_a_moving_ground_names_itself():
