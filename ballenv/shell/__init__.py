@@ -6,9 +6,10 @@ potential (potential.py); damping of the deformation only (damping.py); the mode
 The linear algebra (solve/): the envelope Cholesky (envelope.py), the block-sparse assembly
 (blocks.py), block-Jacobi-preconditioned CG (cg.py, jointcg.py) and an implicit step's linear solve
 (stepsolve.py). At rest (rest/): static equilibrium (equilibrium.py) and linear vibration modes
-(modes.py). What the shell touches (touch/): grounds' barriers (ground.py), lagged Coulomb friction
-(friction.py), distances (distance.py), the barrier between shells and within one with its collision
-detection (contact.py, projection.py) and the broad phase (broadphase.py). The time step (step/): the
+(modes.py). What the shell touches (touch/): grounds' barriers (ground.py) and motion (motion.py),
+lagged Coulomb friction (friction.py), distances (distance.py), the barrier between shells and
+within one with its collision detection (contact.py, projection.py) and the broad phase
+(broadphase.py). The time step (step/): the
 implicit step, backward Euler or generalized-alpha (implicit.py), its incremental potential
 (increment.py) and records (stepdata.py); the joint step of shells that may touch (groups.py,
 joint.py, jointdata.py); the energy budget (budget.py); events (events.py). At the top: the validated

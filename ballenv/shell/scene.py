@@ -1,5 +1,5 @@
 """What to simulate, validated on construction (SI units): ``Shell`` (one inflated ball), ``Ground``
-(a half-space) and ``Scene`` (shells, grounds, effects and the numerical method).
+(a half-space, fixed or moving) and ``Scene`` (shells, grounds, effects and the numerical method).
 
 Every field is checked when the object is made; a bad value raises ``ValueError`` naming the field,
 the value and the valid range, e.g.::
@@ -95,25 +95,53 @@ class Shell:
 
 @dataclass(frozen=True)
 class Ground:
-    """A fixed ground: the half-space ``n . x >= height`` of any orientation.
+    """A ground: the half-space ``n . x >= d(t)`` of any orientation, fixed or moving rigidly.
+
+    Its plane moves with a constant velocity u plus an oscillation along its normal n, so that its
+    offset along n (m) and its surface's velocity (m/s) are (as the ring's grounds,
+    ``ballenv.physics.ground.motion``)::
+
+        d(t) = height + (n . u) t + A sin(2 pi f t),     w(t) = u + A 2 pi f cos(2 pi f t) n
+
+    (touch/motion.py). A vertex's barrier is taken against the plane at the end of each step, and
+    Coulomb friction acts on its slip relative to the surface (a conveyor belt drags a ball along);
+    the work the moving plane does is credited to the shell's energy budget (step/budget.py).
 
     normal: the unit normal n into the free side (any non-zero 3-vector, normalised here);
-    height: the plane's offset (m) along n (the plane is ``n . x = height``); friction: the
-    Coulomb coefficient mu in [0, 10] (0: frictionless).
+    height: the plane's offset d(0) (m) along n at t = 0 (the plane is ``n . x = height``);
+    friction: the Coulomb coefficient mu in [0, 10] (0: frictionless); velocity: u (m/s), each
+    component in [-1000, 1000] (its part along the plane: a conveyor belt; along n: a rising or
+    sinking plate); amplitude: A (m) in [0, 100] of the oscillation along n (0: none); frequency:
+    f (Hz) in [0, 1e5], above 0 when ``amplitude`` is (a vibrating table: peak acceleration
+    ``A (2 pi f)^2`` m/s^2).
     """
 
     normal: tuple[float, float, float] = (0.0, 0.0, 1.0)
     height: float = 0.0
     friction: float = 0.0
+    velocity: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    amplitude: float = 0.0
+    frequency: float = 0.0
 
     def __post_init__(self) -> None:
-        n = check_vector3("Ground", "normal", self.normal, 1e6, "(not all zero)")
+        o, s = "Ground", object.__setattr__
+        n = check_vector3(o, "normal", self.normal, 1e6, "(not all zero)")
         length = math.sqrt(sum(c * c for c in n))
         if not length > 1e-12:
-            fail("Ground", "normal", self.normal, "a non-zero 3-vector")
-        object.__setattr__(self, "normal", (n[0] / length, n[1] / length, n[2] / length))
-        object.__setattr__(self, "height", check_real("Ground", "height", self.height, -1e6, 1e6, "m"))
-        object.__setattr__(self, "friction", check_real("Ground", "friction", self.friction, 0.0, 10.0))
+            fail(o, "normal", self.normal, "a non-zero 3-vector")
+        s(self, "normal", (n[0] / length, n[1] / length, n[2] / length))
+        s(self, "height", check_real(o, "height", self.height, -1e6, 1e6, "m"))
+        s(self, "friction", check_real(o, "friction", self.friction, 0.0, 10.0))
+        s(self, "velocity", check_vector3(o, "velocity", self.velocity, 1e3, "m/s"))
+        s(self, "amplitude", check_real(o, "amplitude", self.amplitude, 0.0, 100.0, "m"))
+        oscillates = self.amplitude > 0.0
+        unit = "Hz (above 0 when amplitude > 0)" if oscillates else "Hz"
+        s(self, "frequency", check_real(o, "frequency", self.frequency, 0.0, 1e5, unit, low_open=oscillates))
+
+    @property
+    def moves(self) -> bool:
+        """The plane moves: a velocity or an oscillation."""
+        return self.velocity != (0.0, 0.0, 0.0) or self.amplitude > 0.0
 
 
 INTEGRATORS = ("generalized_alpha", "backward_euler")
@@ -124,7 +152,8 @@ class Scene:
     """Shells, grounds, the effects acting on them and the numerical method (SI units).
 
     shells: one or more :class:`Shell` (kept apart by a contact barrier); grounds: any number of
-    :class:`Ground` half-spaces. gravity: g (m/s^2) along -z in [0, 1000], or a 3-vector (m/s^2).
+    :class:`Ground` half-spaces (fixed, or moving: a rising plate, a conveyor belt, a vibrating
+    table). gravity: g (m/s^2) along -z in [0, 1000], or a 3-vector (m/s^2).
     damping: c (1/s) in [0, 1e6] of the deformation damping ``F_i = -c m_i (v_i - v_rigid,i)``,
     ``v_rigid`` the mass-weighted least-squares rigid motion (translation plus spin about the
     centre of mass) of the shell's velocities: flight, spin and rolling are not damped.

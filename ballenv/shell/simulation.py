@@ -14,9 +14,12 @@ most ``dt``. Without it, steps are ``dt``, and a halved step doubles back after 
 Records are every accepted step, or, with ``output_dt``, at its multiples, interpolated inside the
 steps (cubic Hermite positions and their derivative; contact forces linearly), which never changes
 the steps.
-Each shell's energy is held to its value at the start (budget.py): an accepted step's small excess
-is taken from its deformation's (or spin's) kinetic energy, a larger one rejects the step. Every
-vertex must start above every ground and outside every other shell (``ValueError`` otherwise).
+Each shell's energy is held to its value at the start plus the work moving grounds have done on it
+(budget.py): an accepted step's small excess is taken from its deformation's (or spin's) kinetic
+energy, a larger one rejects the step. Moving grounds (touch/motion.py) are placed at each trial
+step's end, and the step is shortened so that no plane advances more than half its distance to the
+nearest vertex. Every vertex must start above every ground (at t = 0) and outside every other shell
+(``ValueError`` otherwise).
 """
 
 import time
@@ -32,7 +35,7 @@ from .skin.gas import gauge_pressure, volume
 from .skin.mesh import icosphere, winding_numbers
 from .skin.model import build_model
 from .step import budget, events, groups, implicit, stepdata
-from .touch import ground
+from .touch import ground, motion
 
 F64 = NDArray[np.float64]
 SHRINK = 0.2  # smallest factor of an adaptive step's change
@@ -61,7 +64,10 @@ class Trajectory:
     """t (T,) s; x, v (T, shells, V, 3) m, m/s; contact_force (T, shells, V, 3) N, the grounds'
     barrier and friction force plus the contact barrier's between shells and within one (contact.py);
     pressure (T, shells) Pa gauge; events: ``(t s, shell, kind,
-    centre-of-mass height m)`` with kind "apex", "touchdown" or "liftoff"; stats."""
+    centre-of-mass height m)`` with kind "apex", "touchdown" or "liftoff"; stats; boundary_work
+    (T, shells) J: the work credited to each shell's energy budget for the moving grounds since
+    t = 0 (budget.boundary_work: an upper bound of their work, the step dissipating the rest; 0 on
+    fixed grounds), so that its energy never exceeds its start energy plus this."""
 
     t: F64
     x: F64
@@ -71,6 +77,7 @@ class Trajectory:
     events: list[tuple[float, int, str, float]]
     stats: SimulationStats
     scene: Scene = field(repr=False)
+    boundary_work: F64 = field(default_factory=lambda: np.zeros((0, 0)), repr=False)
 
     def apexes(self, shell: int = 0) -> F64:
         """(k, 2): (t s, centre-of-mass height m) of each apex of ``shell``, located in its step."""
@@ -87,12 +94,13 @@ def build(scene: Scene) -> tuple[implicit.Integrator, list[stepdata.ShellStep]]:
     normals = np.array([gr.normal for gr in scene.grounds], dtype=np.float64).reshape(-1, 3)
     heights = np.array([gr.height for gr in scene.grounds], dtype=np.float64)
     mu = np.array([gr.friction for gr in scene.grounds], dtype=np.float64)
+    slide = np.zeros((len(scene.grounds), 3))
     steps = []
     for shell in scene.shells:
         model = build_model(shell, scene.gas_exponent, scene.atmospheric_pressure)
         kappa = scene.contact_stiffness or shell.youngs_modulus * shell.thickness
         contact = (scene.contact_distance, kappa, scene.friction_velocity)
-        steps.append(stepdata.make_step(model, g, (normals, heights, mu), contact, scene.damping))
+        steps.append(stepdata.make_step(model, g, (normals, heights, mu, slide), contact, scene.damping))
     return method, steps
 
 
@@ -155,26 +163,27 @@ class Recorder:
 
     def __init__(self, output_dt: float | None, steps: list[stepdata.ShellStep]) -> None:
         self.output_dt, self.steps = output_dt, steps
-        self.rows: list[tuple[float, F64, F64, F64, F64]] = []
+        self.rows: list[tuple[float, F64, F64, F64, F64, F64]] = []
         self.count = 0
 
-    def add(self, t: float, x: F64, v: F64, force: F64) -> None:
-        """One record at ``t`` (s)."""
+    def add(self, t: float, x: F64, v: F64, force: F64, work: F64) -> None:
+        """One record at ``t`` (s) (``work`` (shells,) J: the grounds' work so far)."""
         p = [
             gauge_pressure(st.problem.model, volume(x[k], st.problem.model.triangles))
             for k, st in enumerate(self.steps)
         ]
-        self.rows.append((t, x.copy(), v.copy(), force.copy(), np.array(p, dtype=np.float64)))
+        self.rows.append((t, x.copy(), v.copy(), force.copy(), np.array(p, dtype=np.float64), work.copy()))
         self.count += 1
 
-    def step(self, t: float, h: float, before: tuple[F64, F64, F64], after: tuple[F64, F64, F64]) -> None:
-        """Records for the accepted step ``[t, t + h]`` from its ends' ``(x, v, contact force)``."""
+    def step(self, t: float, h: float, before: tuple[F64, ...], after: tuple[F64, ...]) -> None:
+        """Records for the accepted step ``[t, t + h]`` from its ends' ``(x, v, contact force,
+        grounds' work)``."""
         if self.output_dt is None:
             self.add(t + h, *after)
             return
         while self.count * self.output_dt <= t + h * (1.0 + 1e-12):
             s = min(max((self.count * self.output_dt - t) / h, 0.0), 1.0)
-            (x0, v0, f0), (x1, v1, f1) = before, after
+            (x0, v0, f0, w0), (x1, v1, f1, w1) = before, after
             s2, s3 = s * s, s * s * s
             x = (
                 (2 * s3 - 3 * s2 + 1) * x0
@@ -183,11 +192,11 @@ class Recorder:
                 + (s3 - s2) * h * v1
             )
             v = (6 * s2 - 6 * s) * (x0 - x1) / h + (3 * s2 - 4 * s + 1) * v0 + (3 * s2 - 2 * s) * v1
-            self.add(self.count * self.output_dt, x, v, (1.0 - s) * f0 + s * f1)
+            self.add(self.count * self.output_dt, x, v, (1.0 - s) * f0 + s * f1, (1.0 - s) * w0 + s * w1)
 
-    def arrays(self) -> tuple[F64, F64, F64, F64, F64]:
-        """``(t, x, v, contact_force, pressure)`` stacked."""
-        return tuple(np.array([row[k] for row in self.rows]) for k in range(5))  # type: ignore[return-value]
+    def arrays(self) -> tuple[F64, F64, F64, F64, F64, F64]:
+        """``(t, x, v, contact_force, pressure, boundary_work)`` stacked."""
+        return tuple(np.array([row[k] for row in self.rows]) for k in range(6))  # type: ignore[return-value]
 
 
 def error_ratio(
@@ -231,7 +240,8 @@ def next_step(scene: Scene, method: implicit.Integrator, h: float, ratio: float)
 
 class Run:
     """A run's state between steps: positions, velocities, accelerations and contact forces
-    (shells, V, 3), and what it has recorded."""
+    (shells, V, 3), the grounds' work on each shell (J), and what it has recorded; the grounds'
+    motion if one moves (else None)."""
 
     def __init__(self, scene: Scene, x0: ArrayLike | None, v0: ArrayLike | None, output_dt: float | None):
         self.scene = scene
@@ -244,24 +254,37 @@ class Run:
             [implicit.initial_acceleration(st, self.x[k], self.v[k]) for k, st in enumerate(self.steps)]
         )
         self.force = np.zeros_like(self.x)
+        self.work = np.zeros(len(self.steps))
+        moving = any(gr.moves for gr in scene.grounds)
+        st = self.steps[0]
+        self.motion = motion.Motion(scene.grounds, st.heights, st.slide, dhat) if moving else None
         g = np.array(scene.gravity_vector)
         self.up = -g / np.linalg.norm(g) if np.linalg.norm(g) > 0.0 else np.array([0.0, 0.0, 1.0])
         self.recorder, self.stats = Recorder(output_dt, self.steps), SimulationStats()
         self.events: list[tuple[float, int, str, float]] = []
-        self.recorder.add(0.0, self.x, self.v, self.force)
+        self.recorder.add(0.0, self.x, self.v, self.force, self.work)
         self.budget = budget.energies(self.steps, self.x, self.v)
         self.sharing = budget.Sharing(len(self.steps))
 
-    def within_budget(self, results: list[implicit.StepResult]) -> bool:
-        """Holds each shell's step end to its energy budget (budget.py; shells stepped jointly
-        share theirs from then on), scaling the results' velocities in place; False if the step
-        must be rejected."""
+    def boundary_work(self, t: float, h: float, results: list[implicit.StepResult]) -> F64:
+        """(shells,) J: the work the moving grounds did on each shell in the step ``[t, t + h]``
+        just tried (budget.boundary_work); zeros on fixed grounds."""
+        if self.motion is None:
+            return np.zeros(len(self.steps))
+        heights0 = self.motion.offsets(t)
+        pairs = zip(self.steps, results, strict=True)
+        return np.array([budget.boundary_work(st, heights0, r.x, h) for st, r in pairs])
+
+    def within_budget(self, results: list[implicit.StepResult], work: F64) -> bool:
+        """Holds each shell's step end to its energy budget plus ``work`` (J, the grounds' work in
+        the step; budget.py; shells stepped jointly share theirs from then on), scaling the
+        results' velocities in place; False if the step must be rejected."""
         if self.contacts is not None:
             for group in self.contacts.last_groups:
                 self.sharing.join(group)
         for members in self.sharing.sets():
             energy = sum(results[k].energy for k in members)
-            limit = sum(self.budget[k] for k in members)
+            limit = sum(self.budget[k] + work[k] for k in members)
             if energy <= limit:
                 continue
             steps = [self.steps[k] for k in members]
@@ -270,21 +293,26 @@ class Run:
                 return False
         return True
 
-    def accept(self, t: float, h: float, results: list[implicit.StepResult]) -> None:
-        """Takes the step ``[t, t + h]``: its events, records and work."""
+    def accept(self, t: float, h: float, results: list[implicit.StepResult], work: F64) -> None:
+        """Takes the step ``[t, t + h]``: its events, records and work (``work`` (shells,) J the
+        grounds', credited to the budgets)."""
         x1, v1 = np.array([r.x for r in results]), np.array([r.v for r in results])
         f1 = np.array([r.contact_force for r in results])
+        work1 = self.work + work
         for k, st in enumerate(self.steps):
-            d0 = ground.min_distance(self.x[k], st.normals, st.heights)
+            heights0 = st.heights if self.motion is None else self.motion.offsets(t)
+            d0 = ground.min_distance(self.x[k], st.normals, heights0)
             d1 = ground.min_distance(x1[k], st.normals, st.heights)
             ends = (self.x[k], self.v[k], d0), (x1[k], v1[k], d1)
             self.events += events.detect(t, h, k, self.up, st.problem.model.mass, *ends, st.dhat)
-        self.recorder.step(t, h, (self.x, self.v, self.force), (x1, v1, f1))
+        self.recorder.step(t, h, (self.x, self.v, self.force, self.work), (x1, v1, f1, work1))
         self.stats.steps += 1
         self.stats.newton_iterations += sum(r.iterations for r in results)
         self.stats.cg_iterations += sum(r.cg_iterations for r in results)
         self.stats.envelope_solves += sum(r.envelope_solves for r in results)
         self.x, self.v, self.a, self.force = x1, v1, np.array([r.a for r in results]), f1
+        self.budget = [b + w for b, w in zip(self.budget, work, strict=True)]
+        self.work = work1
 
     def reject(self, t: float, h: float, why: str) -> float:
         """Counts a rejected step; returns ``h`` (s), the next try, unless below ``dt_min``."""
@@ -313,6 +341,8 @@ def simulate(
     t, h, clock = 0.0, scene.dt, time.perf_counter()
     while t < t_end * (1.0 - 1e-12):
         trial = min(h, t_end - t)
+        if run.motion is not None:
+            trial = run.motion.prepare(run.x, t, trial)
         try:
             results = try_step(method, run.steps, (run.x, run.v, run.a), trial, run.contacts)
         except implicit.StepFailure:
@@ -323,12 +353,13 @@ def simulate(
         if ratio > 1.0:
             h = run.reject(t, trial * max(SHRINK, 0.9 * ratio**-q), "the error control shrank the step")
             continue
-        if not run.within_budget(results):
+        work = run.boundary_work(t, trial, results)
+        if not run.within_budget(results, work):
             h = run.reject(t, 0.5 * trial, "the step gained energy; halved")
             continue
-        run.accept(t, trial, results)
+        run.accept(t, trial, results, work)
         t += trial
         h = next_step(scene, method, trial, ratio)
     run.stats.wall_time = time.perf_counter() - clock
-    tt, xx, vv, ff, pp = run.recorder.arrays()
-    return Trajectory(tt, xx, vv, ff, pp, sorted(run.events), run.stats, scene)
+    tt, xx, vv, ff, pp, ww = run.recorder.arrays()
+    return Trajectory(tt, xx, vv, ff, pp, sorted(run.events), run.stats, scene, ww)

@@ -46,6 +46,20 @@ def test_a_ground_normalises_its_normal_and_a_scene_its_gravity():
     assert Scene(gravity=(1, 2, -3)).gravity_vector == (1.0, 2.0, -3.0)
 
 
+def test_a_moving_ground_keeps_its_motion_and_an_oscillation_needs_a_frequency():
+    from ballenv.shell import Ground
+
+    belt = Ground(velocity=(1, 0, 0), friction=0.5)
+    assert belt.velocity == (1.0, 0.0, 0.0) and belt.moves
+    assert Ground(amplitude=1e-3, frequency=20).moves and not Ground(frequency=20).moves
+    assert not Ground().moves
+    with pytest.raises(ValueError) as error:
+        Ground(amplitude=1e-3)
+    assert "Ground.frequency = 0.0 is out of range: must be a finite number in (0, 100000] Hz" in str(
+        error.value
+    )
+
+
 @pytest.mark.parametrize(
     "owner, field, value, words",
     [
@@ -62,6 +76,27 @@ def test_a_ground_normalises_its_normal_and_a_scene_its_gravity():
             "Ground.friction = -0.1 is out of range: must be a finite number in [0, 10]",
         ),
         ("Ground", "height", math.nan, "Ground.height"),
+        (
+            "Ground",
+            "velocity",
+            (0.0, 2e3, 0.0),
+            "Ground.velocity = (0.0, 2000.0, 0.0) is out of range: must be three finite numbers in "
+            "[-1000, 1000] m/s",
+        ),
+        ("Ground", "velocity", (1.0, 0.0), "Ground.velocity = (1.0, 0.0) is out of range"),
+        (
+            "Ground",
+            "amplitude",
+            -0.01,
+            "Ground.amplitude = -0.01 is out of range: must be a finite number in [0, 100] m",
+        ),
+        (
+            "Ground",
+            "frequency",
+            -1.0,
+            "Ground.frequency = -1.0 is out of range: must be a finite number in [0,",
+        ),
+        ("Ground", "frequency", math.inf, "Ground.frequency = inf is out of range"),
         ("Scene", "shells", (), "Scene.shells = () is out of range: must be a non-empty sequence of Shell"),
         (
             "Scene",

@@ -10,7 +10,8 @@ For a step of ``h`` (s) from ``x0``, ``v0``, ``a0`` (generalized-alpha's ``alpha
 
 ``x_a = x0 + c_x (x1 - x0)``, ``v_a = (1 - alpha_f) v1 + alpha_f v0``,
 ``y = x0 + h v0 + h^2 ((1/2 - beta) - alpha_m beta / (1 - alpha_m)) a0``; ``Pi`` the skin, gas and
-gravity (potential.py), ``B`` the grounds' barriers (ground.py), ``D`` friction (friction.py), the
+gravity (potential.py), ``B`` the grounds' barriers (ground.py; against the planes at the step's
+end, ``st.heights``), ``D`` friction (friction.py; on the slip relative to ``st.slide``), the
 damping's Rayleigh term (damping.py). Its Hessian (N/m) is
 ``c_M M + c_x K(x_a) + Hess (B + D) + c c_v (M - W W^T)``. The arrays are the records of
 stepdata.py (``st`` a ``ShellStep``, ``sp`` a ``Start``, ``wk`` a ``Work``).
@@ -83,7 +84,7 @@ def incremental(method, st, sp, x1, wk):
     _force_point(sp, x1, wk.xa)
     total += potential.energy(p.model, p.ws, wk.xa, p.loads) / c_x
     e = st.slip_speed * sp.coef[0]
-    total += friction.friction_energy(x1, sp.x0, st.normals, sp.lam, st.mu, e, wk.u3)
+    total += friction.friction_energy(x1, sp.x0, st.normals, st.slide, sp.lam, st.mu, e, wk.u3)
     if st.damping > 0.0:
         kinematics(method, sp, x1, wk.a1, wk.v1, wk.va)
         damping.deformation_rate(wk.va, mass, sp.basis, wk.rate)
@@ -100,7 +101,7 @@ def contact_gradient(st, sp, x1, grad, blocks, u3):
     """Adds the barriers' and friction's gradient (N) and Hessian blocks (N/m) at ``x1``."""
     ground.add_barrier(x1, st.normals, st.heights, st.dhat, st.kappa, grad, blocks)
     e = st.slip_speed * sp.coef[0]
-    friction.add_friction(x1, sp.x0, st.normals, sp.lam, st.mu, e, grad, blocks, u3)
+    friction.add_friction(x1, sp.x0, st.normals, st.slide, sp.lam, st.mu, e, grad, blocks, u3)
 
 
 @kernel

@@ -59,8 +59,9 @@ class ShellStep(NamedTuple):
     problem: Problem  # loads: gravity m_i g (N)
     gravity: float  # |g| m/s^2
     normals: F64  # (G, 3) grounds' unit normals
-    heights: F64  # (G,) m
+    heights: F64  # (G,) m: the planes' offsets at the step's end (touch/motion.py)
     mu: F64  # (G,) friction coefficients
+    slide: F64  # (G, 3) m: the grounds' surfaces' slide over the step (touch/motion.py)
     dhat: float  # m
     kappa: float  # N/m
     slip_speed: float  # eps_v m/s
@@ -93,11 +94,11 @@ def make_work(n_vertices: int, n_grounds: int) -> Work:
 def make_step(
     model: ShellModel,
     gravity: F64,
-    grounds: tuple[F64, F64, F64],
+    grounds: tuple[F64, F64, F64, F64],
     contact: tuple[float, float, float],
     c: float,
 ) -> ShellStep:
-    """The step data of ``model`` under ``gravity`` (3,) m/s^2, ``grounds`` (normals, heights, mu),
+    """The step data of ``model`` under ``gravity`` (3,) m/s^2, ``grounds`` (normals, heights, mu, slide),
     ``contact`` (dhat m, kappa N/m, eps_v m/s) and damping ``c`` (1/s)."""
     n, n_grounds = len(model.rest), len(grounds[1])
     loads = model.mass[:, None] * gravity[None, :]
