@@ -54,12 +54,13 @@ BASELINE_SCRIPT = """
 import json, os, sys
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 from ballenv.shell import Ground, Scene, Shell, simulate
-k, rtol, t_end = int(sys.argv[1]), float(sys.argv[2]), float(sys.argv[3])
+from ballenv.shell.presets import with_fidelity
+k, rtol, t_end, preset = int(sys.argv[1]), float(sys.argv[2]), float(sys.argv[3]), sys.argv[4]
 low = Shell(subdivisions=k, position=(0.0, 0.0, 0.128), velocity=(0.0, 0.0, -1.0))
 simulate(Scene(shells=[low], grounds=[Ground(friction=0.5)], rtol=rtol), t_end=0.005)  # compile
 ball = Shell(subdivisions=k, position=(0.0, 0.0, 0.5))
 scene = Scene(shells=[ball], grounds=[Ground(friction=0.5)], rtol=rtol)
-traj = simulate(scene, t_end=t_end)
+traj = simulate(with_fidelity(scene, preset) if preset != "-" else scene, t_end=t_end)
 print(json.dumps({"wall": traj.stats.wall_time, "steps": traj.stats.steps, "apex": traj.apexes()[0, 1]}))
 """
 COLD_SCRIPT = """
@@ -87,11 +88,13 @@ def warm(subdivisions: int, rtol: float) -> None:
     simulate(scene_of(subdivisions, rtol, height=0.135, speed=1.0), t_end=0.005)
 
 
-def baseline(directory: str, subdivisions: int, rtol: float, t_end: float) -> dict:
-    """The same run by the code in ``directory``: its wall time (s), steps, first apex (m)."""
+def baseline(directory: str, subdivisions: int, rtol: float, t_end: float, preset: str | None) -> dict:
+    """The same run by the code in ``directory`` (its own ``preset``, if given): its wall time (s),
+    steps, first apex (m)."""
     env = {**os.environ, "PYTHONPATH": directory}
+    args = [str(subdivisions), str(rtol), str(t_end), preset or "-"]
     out = subprocess.run(
-        [sys.executable, "-c", BASELINE_SCRIPT, str(subdivisions), str(rtol), str(t_end)],
+        [sys.executable, "-c", BASELINE_SCRIPT, *args],
         env=env, capture_output=True, text=True, check=True, cwd=directory,
     )  # fmt: skip
     return json.loads(out.stdout.strip().splitlines()[-1])
@@ -109,7 +112,7 @@ def run(subdivisions: int, preset: str | None, reference: float, old: str | None
     scene = scene_of(subdivisions, rtol, preset=preset)
     warm(subdivisions, rtol)
     t_end = 2.4
-    before = baseline(old, subdivisions, rtol, t_end) if old else None
+    before = baseline(old, subdivisions, rtol, t_end, preset) if old else None
     traj = simulate(scene, t_end=t_end)
     apexes = traj.apexes()
     last_apex = apexes[BOUNCES - 1, 0] if len(apexes) >= BOUNCES else t_end
@@ -206,7 +209,7 @@ def main() -> None:
     rows = []
     for k in (2, 3):
         reference = reference_apex(k)
-        rows += [run(k, None, reference, args.baseline), run(k, PRESETS[k], reference, None)]
+        rows += [run(k, None, reference, args.baseline), run(k, PRESETS[k], reference, args.baseline)]
     scale = [scaling(k) for k in (2, 3, 4)]
     name = pathlib.Path(__file__).relative_to(pathlib.Path(__file__).parents[1])
     text = (
@@ -216,8 +219,9 @@ def main() -> None:
         "Real time is simulated seconds per wall-clock second; the ratio to target is that over the "
         "target (>= 1 meets it). The apexes are the centre of mass's heights, located inside the steps. "
         f"First-apex error: against a run at rtol = {REFERENCE_RTOL:g} of the same mesh. "
-        "Old wall per step and speed-up: the code given by `--baseline`, run just before in the same "
-        "process's minutes, over the whole run to 2.4 s (- where not run).\n\n"
+        "Old wall per step and speed-up: the code given by `--baseline` (with its own preset's "
+        "settings on the preset rows), run just before in the same minutes, over the whole run to "
+        "2.4 s (- where not run).\n\n"
         f"Cost against the vertex count (the first {SCALING_END:g} s, rtol = {DEFAULT_RTOL:g}):\n\n"
         + scaling_table(scale)
         + "\nThe first drop in a new process with an empty numba cache (compiling the shell): "

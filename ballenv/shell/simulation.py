@@ -24,6 +24,7 @@ nearest vertex. Every vertex must start above every ground (at t = 0) and outsid
 
 import time
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -199,12 +200,27 @@ class Recorder:
         return tuple(np.array([row[k] for row in self.rows]) for k in range(6))  # type: ignore[return-value]
 
 
+class Control(NamedTuple):
+    """The integrator's error estimate ``e = c h^2 (a1 - w a0)`` and step exponent ``q`` (module doc)."""
+
+    c: float
+    w: float
+    q: float
+
+
+def control(method: implicit.Integrator) -> Control:
+    """The step control's constants of ``method``."""
+    s = method.solver
+    return Control(
+        integrator.error_coefficient(s), integrator.error_start_weight(s), integrator.error_exponent(s)
+    )
+
+
 def error_ratio(
-    scene: Scene, method: implicit.Integrator, steps: list[stepdata.ShellStep], a0: F64, a1: F64, h: float
+    scene: Scene, ctl: Control, steps: list[stepdata.ShellStep], a0: F64, a1: F64, h: float
 ) -> float:
     """The largest over shells of ``RMS_i |e_i| / (rtol R)`` (module doc)."""
-    c = integrator.error_coefficient(method.solver)
-    w = integrator.error_start_weight(method.solver)
+    c, w = ctl.c, ctl.w
     worst = 0.0
     for k, st in enumerate(steps):
         e = c * h * h * (a1[k] - w * a0[k])
@@ -227,11 +243,10 @@ def try_step(
     return [implicit.step(method, st, x[k], v[k], a[k], h) for k, st in enumerate(steps)]
 
 
-def next_step(scene: Scene, method: implicit.Integrator, h: float, ratio: float) -> float:
-    """The step after an accepted one of ``h`` whose error ratio was ``ratio``."""
+def next_step(scene: Scene, q: float, h: float, ratio: float) -> float:
+    """The step after an accepted one of ``h`` whose error ratio was ``ratio`` (``q``: Control.q)."""
     if not scene.adaptive:
         return min(scene.dt, 2.0 * h)
-    q = integrator.error_exponent(method.solver)
     grow = (
         integrator.STEP_GROWTH if ratio <= 0.0 else min(integrator.STEP_GROWTH, max(SHRINK, 0.9 * ratio**-q))
     )
@@ -263,8 +278,16 @@ class Run:
         self.recorder, self.stats = Recorder(output_dt, self.steps), SimulationStats()
         self.events: list[tuple[float, int, str, float]] = []
         self.recorder.add(0.0, self.x, self.v, self.force, self.work)
+        self.ends = [self.end(k, self.x[k], self.v[k]) for k in range(len(self.steps))]
         self.budget = budget.energies(self.steps, self.x, self.v)
         self.sharing = budget.Sharing(len(self.steps))
+
+    def end(self, k: int, x: F64, v: F64) -> tuple[float, float, float]:
+        """Shell ``k``'s events.end at positions ``x`` and velocities ``v``, against the grounds
+        where the last step tried left them."""
+        st = self.steps[k]
+        gap = ground.min_distance(x, st.normals, st.heights)
+        return events.end(self.up, st.problem.model.mass, x, v, gap)
 
     def boundary_work(self, t: float, h: float, results: list[implicit.StepResult]) -> F64:
         """(shells,) J: the work the moving grounds did on each shell in the step ``[t, t + h]``
@@ -299,12 +322,10 @@ class Run:
         x1, v1 = np.array([r.x for r in results]), np.array([r.v for r in results])
         f1 = np.array([r.contact_force for r in results])
         work1 = self.work + work
+        ends = [self.end(k, x1[k], v1[k]) for k in range(len(self.steps))]
         for k, st in enumerate(self.steps):
-            heights0 = st.heights if self.motion is None else self.motion.offsets(t)
-            d0 = ground.min_distance(self.x[k], st.normals, heights0)
-            d1 = ground.min_distance(x1[k], st.normals, st.heights)
-            ends = (self.x[k], self.v[k], d0), (x1[k], v1[k], d1)
-            self.events += events.detect(t, h, k, self.up, st.problem.model.mass, *ends, st.dhat)
+            self.events += events.detect(t, h, k, self.ends[k], ends[k], st.dhat)
+        self.ends = ends
         self.recorder.step(t, h, (self.x, self.v, self.force, self.work), (x1, v1, f1, work1))
         self.stats.steps += 1
         self.stats.newton_iterations += sum(r.iterations for r in results)
@@ -337,7 +358,7 @@ def simulate(
             f"output_dt = {output_dt!r} is out of range: must be None or a number in (0, t_end] s"
         )
     run = Run(scene, x0, v0, output_dt)
-    method, q = run.method, integrator.error_exponent(run.method.solver)
+    method, ctl = run.method, control(run.method)
     t, h, clock = 0.0, scene.dt, time.perf_counter()
     while t < t_end * (1.0 - 1e-12):
         trial = min(h, t_end - t)
@@ -349,9 +370,9 @@ def simulate(
             h = run.reject(t, 0.5 * trial, "the step was halved")
             continue
         a1 = np.array([r.a for r in results])
-        ratio = error_ratio(scene, method, run.steps, run.a, a1, trial) if scene.adaptive else 0.0
+        ratio = error_ratio(scene, ctl, run.steps, run.a, a1, trial) if scene.adaptive else 0.0
         if ratio > 1.0:
-            h = run.reject(t, trial * max(SHRINK, 0.9 * ratio**-q), "the error control shrank the step")
+            h = run.reject(t, trial * max(SHRINK, 0.9 * ratio**-ctl.q), "the error control shrank the step")
             continue
         work = run.boundary_work(t, trial, results)
         if not run.within_budget(results, work):
@@ -359,7 +380,7 @@ def simulate(
             continue
         run.accept(t, trial, results, work)
         t += trial
-        h = next_step(scene, method, trial, ratio)
+        h = next_step(scene, ctl.q, trial, ratio)
     run.stats.wall_time = time.perf_counter() - clock
     tt, xx, vv, ff, pp, ww = run.recorder.arrays()
     return Trajectory(tt, xx, vv, ff, pp, sorted(run.events), run.stats, scene, ww)

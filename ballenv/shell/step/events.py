@@ -14,6 +14,8 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
+F64 = NDArray[np.float64]
+
 
 def hermite(y0: float, y1: float, d0: float, d1: float, s: float) -> float:
     """Cubic Hermite on [0, 1] with end values y0, y1 and end slopes d0, d1 (per unit s)."""
@@ -41,20 +43,24 @@ def centre(mass: NDArray[np.float64], x: NDArray[np.float64]) -> NDArray[np.floa
     return mass @ x / mass.sum()
 
 
+def end(up: F64, mass: F64, x: F64, v: F64, gap: float) -> tuple[float, float, float]:
+    """A step end's ``(z m, w m/s, gap m)``: the centre of mass's height along ``up`` and its rate,
+    and the smallest ground distance ``gap`` given, of positions ``x`` and velocities ``v`` (V, 3)."""
+    return float(up @ centre(mass, x)), float(up @ centre(mass, v)), gap
+
+
 def detect(
-    t: float, h: float, shell: int, up: NDArray[np.float64], mass: NDArray[np.float64],
-    before: tuple[NDArray[np.float64], NDArray[np.float64], float],
-    after: tuple[NDArray[np.float64], NDArray[np.float64], float], dhat: float,
+    t: float, h: float, shell: int, before: tuple[float, float, float], after: tuple[float, float, float],
+    dhat: float,
 ) -> list[tuple[float, int, str, float]]:  # fmt: skip
-    """Events ``(time s, shell, kind, centre-of-mass height m)`` of the step, from the ``(x, v,
-    smallest ground distance)`` at its ``before`` and ``after`` ends."""
-    z0, z1 = float(up @ centre(mass, before[0])), float(up @ centre(mass, after[0]))
-    w0, w1 = float(up @ centre(mass, before[1])), float(up @ centre(mass, after[1]))
+    """Events ``(time s, shell, kind, centre-of-mass height m)`` of the step, from the :func:`end`
+    of its ``before`` and ``after`` ends."""
+    (z0, w0, gap0), (z1, w1, gap1) = before, after
     out = []
     if w0 > 0.0 >= w1:
         s = apex_fraction(z0, z1, h * w0, h * w1)
         out.append((t + s * h, shell, "apex", hermite(z0, z1, h * w0, h * w1, s)))
-    g0, g1 = before[2] - dhat, after[2] - dhat
+    g0, g1 = gap0 - dhat, gap1 - dhat
     if (g0 >= 0.0) != (g1 >= 0.0):
         s = g0 / (g0 - g1)
         kind = "touchdown" if g1 < 0.0 else "liftoff"
