@@ -162,7 +162,7 @@ def newton(method, st, sp, wk, matrices):
     lightest = math.inf
     for i in range(mass.shape[0]):
         lightest = min(lightest, mass[i])
-    e = increment.incremental(method, st, sp, wk.x, wk)
+    e = math.nan  # Phi at wk.x, evaluated once a line search needs it
     for iteration in range(method.solver.newton_max_iter + 1):
         increment.incremental_gradient(method, st, sp, wk.x, wk, wk.grad, wk.blocks)
         residual = residual_acceleration(wk.grad, mass)
@@ -181,6 +181,8 @@ def newton(method, st, sp, wk, matrices):
             return 3, iteration, cg_total, envelope_solves
         cg_total += max(iterations, 0)
         envelope_solves += iterations == -1
+        if iteration == 0:
+            e = increment.incremental(method, st, sp, wk.x, wk)
         e = search(method, st, sp, wk, e)
         if math.isnan(e):
             return 4, iteration, cg_total, envelope_solves
