@@ -156,10 +156,10 @@ def _check_drums(scene: Scene, xs: F64, given: bool) -> None:
             if gap <= 0.0:
                 name = "x0" if given else f"Scene.shells[{k}].position"
                 value = "given" if given else shell.position
-                side = "inside" if dr.inside else "outside"
+                side, wrong = ("inside", "outside") if dr.inside else ("outside", "inside")
                 raise ValueError(
-                    f"{name} = {value} is out of range: shell {k} starts {-gap:.4g} m through the "
-                    f"surface of drums[{j}]; every vertex must start {side} every drum it is {side} of"
+                    f"{name} = {value} is out of range: shell {k} starts {-gap:.4g} m {wrong} "
+                    f"drums[{j}]; every vertex must start {side} it"
                 )
 
 
