@@ -156,3 +156,27 @@ def test_a_vertex_outside_an_inside_drum_or_inside_an_outside_one_is_an_error():
         simulate(Scene(shells=[SHELL], drums=[Drum(radius=0.2)]), t_end=0.01)
     with pytest.raises(ValueError, match=r"m inside drums\[1\]; every vertex must start outside it"):
         simulate(Scene(shells=[SHELL], drums=[Drum(radius=R), Drum(radius=0.05, inside=False)]), t_end=0.01)
+
+
+@pytest.mark.slow  # compiles the joint step of shells in contact with drums (about 2 min, once)
+def test_two_balls_colliding_along_a_frictionless_drum_keep_their_momentum_along_its_axis():
+    """The drum pushes only across its axis and the balls' contact is frictionless: the momentum
+    along the axis is the first ball's throughout, and the collision hands it to the second."""
+    ball = Shell(subdivisions=1)
+    x = equilibrium(ball).x
+    mass = build_model(ball).mass
+    radius = float(np.linalg.norm(x - centre(mass, x), axis=1).max())
+    depth = -(R - radius - 2e-3)  # 2 mm above the bottom
+    xs = np.stack([x - centre(mass, x) + np.array([0.0, y, depth]) for y in (-0.15, 0.15)])
+    vs = np.zeros_like(xs)
+    vs[0, :, 1] = 0.5  # m/s along the axis, toward the other ball
+    scene = Scene(shells=[ball, ball], drums=[Drum(radius=R)])
+    traj = simulate(scene, t_end=0.2, x0=xs, v0=vs, output_dt=0.01)
+    assert axis_distance(traj.x).max() < R
+    momentum = np.einsum("v,tsv->t", mass, traj.v[..., 1])
+    assert momentum == pytest.approx(0.5 * mass.sum(), rel=1e-6)
+    v = centre(mass, traj.v)[-1, :, 1]
+    # equal masses with a restitution e in (0, 1]: v0' = (1 - e) v / 2 in [0, v/2), v1' = (1 + e) v / 2
+    assert 0.0 <= v[0] < 0.25 < v[1] <= 0.5
+    gap = np.linalg.norm(centre(mass, traj.x)[:, 0] - centre(mass, traj.x)[:, 1], axis=1)
+    assert gap.min() < 2 * radius + 1e-3  # they touched
