@@ -1,5 +1,6 @@
 """What to simulate, validated on construction (SI units): ``Shell`` (one inflated ball), ``Ground``
-(a half-space, fixed or moving) and ``Scene`` (shells, grounds, effects and the numerical method).
+(a half-space, fixed or moving), ``Drum`` (a turning cylinder the shells stay inside or outside) and
+``Scene`` (shells, grounds, drums, effects and the numerical method).
 
 Every field is checked when the object is made; a bad value raises ``ValueError`` naming the field,
 the value and the valid range, e.g.::
@@ -144,6 +145,60 @@ class Ground:
         return self.velocity != (0.0, 0.0, 0.0) or self.amplitude > 0.0
 
 
+@dataclass(frozen=True)
+class Drum:
+    """A drum: an infinitely long circular cylinder of radius R about the line through ``centre`` c
+    along the unit ``axis`` a, which the shells stay inside (``R - rho >= 0``) or outside
+    (``rho - R >= 0``), ``rho = |(I - a a^T)(x - c)|`` (m) a point's distance from the axis.
+
+    It turns about its axis at the angular velocity (rad/s, right-handed about a)::
+
+        Omega(t) = Omega_0 min(1, t / T)          (T = 0: Omega_0 from the start)
+
+    (the ring's drums, ``ballenv.physics.ground.motion``), its surface moving with
+    ``w(x, t) = Omega(t) a x (x - c)`` (m/s), along the surface: the geometry never changes. A vertex
+    is held off it by the grounds' barrier on its distance ``R - rho`` or ``rho - R`` (touch/drum.py),
+    Coulomb friction acts on its slip relative to the surface (touch/drum_friction.py), and the
+    work the turning drum does through friction is credited to the shell's energy budget
+    (step/budget.py).
+
+    radius: R (m) in (0, 1e6]; centre: c (m), each component in [-1e6, 1e6]; axis: a (any non-zero
+    3-vector, normalised here); inside: True (default): the shells are inside the drum, False:
+    outside it (a round obstacle); friction: the Coulomb coefficient mu in [0, 10] (0:
+    frictionless); angular_velocity: Omega_0 (rad/s) in [-1e4, 1e4] (0: a fixed drum); spin_up: T
+    (s) in [0, 1e6] over which Omega grows linearly from 0 to Omega_0 (0: none).
+    """
+
+    radius: float = 1.0
+    centre: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    axis: tuple[float, float, float] = (0.0, 1.0, 0.0)
+    inside: bool = True
+    friction: float = 0.0
+    angular_velocity: float = 0.0
+    spin_up: float = 0.0
+
+    def __post_init__(self) -> None:
+        o, s = "Drum", object.__setattr__
+        s(self, "radius", check_real(o, "radius", self.radius, 0.0, 1e6, "m", low_open=True))
+        s(self, "centre", check_vector3(o, "centre", self.centre, 1e6, "m"))
+        a = check_vector3(o, "axis", self.axis, 1e6, "(not all zero)")
+        length = math.sqrt(sum(c * c for c in a))
+        if not length > 1e-12:
+            fail(o, "axis", self.axis, "a non-zero 3-vector")
+        s(self, "axis", (a[0] / length, a[1] / length, a[2] / length))
+        if not isinstance(self.inside, bool):
+            fail(o, "inside", self.inside, "True or False")
+        s(self, "friction", check_real(o, "friction", self.friction, 0.0, 10.0))
+        spin = check_real(o, "angular_velocity", self.angular_velocity, -1e4, 1e4, "rad/s")
+        s(self, "angular_velocity", spin)
+        s(self, "spin_up", check_real(o, "spin_up", self.spin_up, 0.0, 1e6, "s"))
+
+    @property
+    def moves(self) -> bool:
+        """The drum turns."""
+        return self.angular_velocity != 0.0
+
+
 INTEGRATORS = ("generalized_alpha", "backward_euler")
 
 
@@ -153,7 +208,9 @@ class Scene:
 
     shells: one or more :class:`Shell` (kept apart by a contact barrier); grounds: any number of
     :class:`Ground` half-spaces (fixed, or moving: a rising plate, a conveyor belt, a vibrating
-    table). gravity: g (m/s^2) along -z in [0, 1000], or a 3-vector (m/s^2).
+    table); drums: any number of :class:`Drum` cylinders (default none) the shells stay inside or
+    outside, fixed or turning about their axes. gravity: g (m/s^2) along -z in [0, 1000], or a
+    3-vector (m/s^2).
     damping: c (1/s) in [0, 1e6] of the deformation damping ``F_i = -c m_i (v_i - v_rigid,i)``,
     ``v_rigid`` the mass-weighted least-squares rigid motion (translation plus spin about the
     centre of mass) of the shell's velocities: flight, spin and rolling are not damped.
@@ -191,6 +248,7 @@ class Scene:
     newton_tol: float = 1e-9
     newton_max_iter: int = 30
     self_contact: bool = False
+    drums: Sequence[Drum] = ()
 
     def __post_init__(self) -> None:
         o, s = "Scene", object.__setattr__
@@ -226,6 +284,7 @@ class Scene:
         )
         s(self, "newton_tol", check_real(o, "newton_tol", self.newton_tol, 1e-14, 1e-2))
         s(self, "newton_max_iter", check_int(o, "newton_max_iter", self.newton_max_iter, 1, 200))
+        s(self, "drums", check_sequence(o, "drums", self.drums, Drum, allow_empty=True))
         if not isinstance(self.self_contact, bool):
             fail(o, "self_contact", self.self_contact, "True or False")
         for k, shell in enumerate(self.shells):

@@ -18,7 +18,8 @@ Each shell's energy is held to its value at the start plus the work moving groun
 (budget.py): an accepted step's small excess is taken from its deformation's (or spin's) kinetic
 energy, a larger one rejects the step. Moving grounds (touch/motion.py) are placed at each trial
 step's end, and the step is shortened so that no plane advances more than half its distance to the
-nearest vertex. Every vertex must start above every ground (at t = 0) and outside every other shell
+nearest vertex; turning drums (touch/turning.py) are turned through each trial step. Every vertex
+must start above every ground, on its side of every drum (at t = 0) and outside every other shell
 (``ValueError`` otherwise).
 """
 
@@ -36,7 +37,7 @@ from .skin.gas import gauge_pressure, volume
 from .skin.mesh import icosphere, winding_numbers
 from .skin.model import build_model
 from .step import budget, events, groups, implicit, stepdata
-from .touch import ground, motion
+from .touch import drum, ground, motion, turning
 
 F64 = NDArray[np.float64]
 SHRINK = 0.2  # smallest factor of an adaptive step's change
@@ -96,12 +97,16 @@ def build(scene: Scene) -> tuple[implicit.Integrator, list[stepdata.ShellStep]]:
     heights = np.array([gr.height for gr in scene.grounds], dtype=np.float64)
     mu = np.array([gr.friction for gr in scene.grounds], dtype=np.float64)
     slide = np.zeros((len(scene.grounds), 3))
-    steps = []
+    steps: list[stepdata.ShellStep] = []
     for shell in scene.shells:
         model = build_model(shell, scene.gas_exponent, scene.atmospheric_pressure)
         kappa = scene.contact_stiffness or shell.youngs_modulus * shell.thickness
         contact = (scene.contact_distance, kappa, scene.friction_velocity)
-        steps.append(stepdata.make_step(model, g, (normals, heights, mu, slide), contact, scene.damping))
+        drums = None
+        if scene.drums:
+            drums = drum.make_drums(scene.drums, len(model.rest), steps[0].drums if steps else None)
+        grounds = (normals, heights, mu, slide)
+        steps.append(stepdata.make_step(model, g, grounds, contact, scene.damping, drums))
     return method, steps
 
 
@@ -128,6 +133,7 @@ def initial_states(scene: Scene, x0: ArrayLike | None, v0: ArrayLike | None) -> 
     if not (np.all(np.isfinite(xs)) and np.all(np.isfinite(vs))):
         raise ValueError(f"x0 and v0 must be finite arrays of shape {shape} (m, m/s)")
     _check_apart(scene, xs, x0 is not None)
+    _check_drums(scene, xs, x0 is not None)
     for k, shell in enumerate(scene.shells):
         for g, gr in enumerate(scene.grounds):
             gap = float((xs[k] @ np.array(gr.normal)).min()) - gr.height
@@ -139,6 +145,23 @@ def initial_states(scene: Scene, x0: ArrayLike | None, v0: ArrayLike | None) -> 
                     f"grounds[{g}]; every vertex must start above every ground"
                 )
     return xs, vs
+
+
+def _check_drums(scene: Scene, xs: F64, given: bool) -> None:
+    """``ValueError`` if a vertex starts on the wrong side of a drum (at t = 0)."""
+    for k, shell in enumerate(scene.shells):
+        for j, dr in enumerate(scene.drums):
+            axis, r = np.array(dr.axis), xs[k] - np.array(dr.centre)
+            rho = np.linalg.norm(r - np.outer(r @ axis, axis), axis=1)
+            gap = float((dr.radius - rho if dr.inside else rho - dr.radius).min())
+            if gap <= 0.0:
+                name = "x0" if given else f"Scene.shells[{k}].position"
+                value = "given" if given else shell.position
+                side, wrong = ("inside", "outside") if dr.inside else ("outside", "inside")
+                raise ValueError(
+                    f"{name} = {value} is out of range: shell {k} starts {-gap:.4g} m {wrong} "
+                    f"drums[{j}]; every vertex must start {side} it"
+                )
 
 
 def _check_apart(scene: Scene, xs: F64, given: bool) -> None:
@@ -256,7 +279,7 @@ def next_step(scene: Scene, q: float, h: float, ratio: float) -> float:
 class Run:
     """A run's state between steps: positions, velocities, accelerations and contact forces
     (shells, V, 3), the grounds' work on each shell (J), and what it has recorded; the grounds'
-    motion if one moves (else None)."""
+    motion if one moves (else None), the drums' turning if one turns (else None)."""
 
     def __init__(self, scene: Scene, x0: ArrayLike | None, v0: ArrayLike | None, output_dt: float | None):
         self.scene = scene
@@ -273,6 +296,8 @@ class Run:
         moving = any(gr.moves for gr in scene.grounds)
         st = self.steps[0]
         self.motion = motion.Motion(scene.grounds, st.heights, st.slide, dhat) if moving else None
+        turns = st.drums is not None and any(dr.moves for dr in scene.drums)
+        self.turning = turning.Turning(scene.drums, st.drums.turn) if turns and st.drums is not None else None
         g = np.array(scene.gravity_vector)
         self.up = -g / np.linalg.norm(g) if np.linalg.norm(g) > 0.0 else np.array([0.0, 0.0, 1.0])
         self.recorder, self.stats = Recorder(output_dt, self.steps), SimulationStats()
@@ -287,14 +312,16 @@ class Run:
         where the last step tried left them."""
         st = self.steps[k]
         gap = ground.min_distance(x, st.normals, st.heights)
+        if st.drums is not None:
+            gap = min(gap, drum.min_distance(x, st.drums))
         return events.end(self.up, st.problem.model.mass, x, v, gap)
 
     def boundary_work(self, t: float, h: float, results: list[implicit.StepResult]) -> F64:
         """(shells,) J: the work the moving grounds did on each shell in the step ``[t, t + h]``
         just tried (budget.boundary_work); zeros on fixed grounds."""
-        if self.motion is None:
+        if self.motion is None and self.turning is None:
             return np.zeros(len(self.steps))
-        heights0 = self.motion.offsets(t)
+        heights0 = self.steps[0].heights if self.motion is None else self.motion.offsets(t)
         pairs = zip(self.steps, results, strict=True)
         return np.array([budget.boundary_work(st, heights0, r.x, h) for st, r in pairs])
 
@@ -364,6 +391,8 @@ def simulate(
         trial = min(h, t_end - t)
         if run.motion is not None:
             trial = run.motion.prepare(run.x, t, trial)
+        if run.turning is not None:
+            run.turning.prepare(t, trial)
         try:
             results = try_step(method, run.steps, (run.x, run.v, run.a), trial, run.contacts)
         except implicit.StepFailure:

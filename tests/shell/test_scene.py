@@ -120,3 +120,39 @@ def test_a_bad_ground_or_scene_field_names_itself_its_value_and_its_range(owner,
     with pytest.raises(ValueError) as error:
         {"Ground": Ground, "Scene": Scene}[owner](**{field: value})
     assert words in str(error.value)
+
+
+def test_a_drum_normalises_its_axis_and_a_scene_keeps_its_drums():
+    from ballenv.shell import Drum, Scene
+
+    drum = Drum(radius=0.5, centre=(0, 0, 1), axis=(0, 3, 4), friction=0.4, angular_velocity=2, spin_up=0.5)
+    assert drum.axis == pytest.approx((0.0, 0.6, 0.8)) and drum.inside and drum.moves
+    assert not Drum().moves
+    assert Scene(drums=drum).drums == (drum,) and Scene().drums == ()
+
+
+@pytest.mark.parametrize(
+    ("field", "value", "words"),
+    [
+        ("radius", 0.0, "Drum.radius = 0.0 is out of range: must be a finite number in (0, 1e+06] m"),
+        ("radius", math.nan, "Drum.radius = nan is out of range"),
+        ("centre", (0.0, 1.0), "Drum.centre = (0.0, 1.0) is out of range: must be three finite numbers"),
+        ("axis", (0.0, 0.0, 0.0), "Drum.axis = (0.0, 0.0, 0.0) is out of range: must be a non-zero 3-vector"),
+        ("inside", 1, "Drum.inside = 1 is out of range: must be True or False"),
+        ("friction", -0.1, "Drum.friction = -0.1 is out of range: must be a finite number in [0, 10]"),
+        (
+            "angular_velocity",
+            2e4,
+            "Drum.angular_velocity = 20000.0 is out of range: must be a finite number in",
+        ),
+        ("spin_up", -1.0, "Drum.spin_up = -1.0 is out of range: must be a finite number in [0, 1e+06] s"),
+    ],
+)
+def test_a_bad_drum_field_names_itself_its_value_and_its_range(field, value, words):
+    from ballenv.shell import Drum, Scene
+
+    with pytest.raises(ValueError) as error:
+        Drum(**{field: value})
+    assert words in str(error.value)
+    with pytest.raises(ValueError, match="Scene.drums"):
+        Scene(drums=[object()])

@@ -1,12 +1,12 @@
 """A shell's energy budget: what it may hold after a step, and the removal of a small excess.
 
 The gas, gravity and the barriers are potentials; damping and friction only remove energy; only a
-moving ground adds it, by the work it does (:func:`boundary_work`). So a shell's energy (kinetic +
-stretching + bending + gas + gravity + barriers, J: ``implicit.total_energy``) may never rise above
-its value at the start plus the work the grounds have done on it since, its budget (with fixed
-grounds: its start energy); shells that have stepped jointly (they may have touched and exchanged
-energy) share theirs: their energies and the barrier between them may not rise above the sum of
-their budgets. Generalized-alpha is not energy-stable for a
+moving ground or a turning drum adds it, by the work it does (:func:`boundary_work`). So a shell's
+energy (kinetic + stretching + bending + gas + gravity + barriers, J: ``implicit.total_energy``) may
+never rise above its value at the start plus the work the grounds have done on it since, its budget
+(with fixed grounds: its start energy); shells that have stepped jointly (they may have touched and
+exchanged energy) share theirs: their energies and the barrier between them may not rise above the
+sum of their budgets. Generalized-alpha is not energy-stable for a
 nonlinear shell: a fast-spinning ball gains energy of order ``h^2`` over its first revolutions
 (the discrete rotation stretches it) before the gain levels off. An accepted step whose
 energy lies above the budget by ``excess`` (J) is corrected as the ring's
@@ -28,7 +28,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..skin import damping
-from ..touch import friction, ground
+from ..touch import drum_friction, friction, ground
 from .implicit import total_energy
 from .stepdata import ShellStep
 
@@ -73,17 +73,20 @@ def boundary_work(st: ShellStep, heights0: F64, x1: F64, h: float) -> float:
     plane moved first, with the shell held at ``x0``, and the shell then stepped against fixed
     planes: the first term (the barriers' energy ``B``, ground.py) is what that move did; the
     second, the work of friction's force ``F = -grad D`` (N, at ``x1``, friction.py) through the
-    surfaces' slides ``s_g`` (m). A moving ground's power on a vertex, ``f . v = f . w + f . (v - w)``,
-    is its work; the rest (friction on the slip) only dissipates. The first term bounds what a
-    dissipative step can gain from the move, so a legitimate gain is never clipped; it exceeds the
-    work ``lambda n . (d(t1) - d(t0))`` by about ``k (n . (d(t1) - d(t0)))^2 / 2`` (``k`` the
-    barrier's stiffness, N/m), which the step dissipates: a ball carried up by a plate is credited
-    a few times the work of lifting it. 0 on fixed grounds."""
+    surfaces' slides ``s_g`` (m), and likewise through the turning drums' (drum_friction.py; a drum's
+    geometry does not move, so it has no first term). A moving ground's power on a vertex,
+    ``f . v = f . w + f . (v - w)``, is its work; the rest (friction on the slip) only dissipates. The
+    first term bounds what a dissipative step can gain from the move, so a legitimate gain is never
+    clipped; it exceeds the work ``lambda n . (d(t1) - d(t0))`` by about ``k (n . (d(t1) - d(t0)))^2
+    / 2`` (``k`` the barrier's stiffness, N/m), which the step dissipates: a ball carried up by a
+    plate is credited a few times the work of lifting it. 0 on fixed grounds."""
     sp, n = st.start, st.normals
     lift = ground.barrier_energy(sp.x0, n, st.heights, st.dhat, st.kappa)
     lift -= ground.barrier_energy(sp.x0, n, heights0, st.dhat, st.kappa)
     e = st.slip_speed * h
     drag = friction.friction_work(np.ascontiguousarray(x1), sp.x0, n, st.slide, sp.lam, st.mu, e, st.work.u3)
+    if st.drums is not None:
+        drag += drum_friction.friction_work(np.ascontiguousarray(x1), sp.x0, st.drums, e)
     return float(lift + drag)
 
 

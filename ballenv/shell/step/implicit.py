@@ -41,7 +41,7 @@ from ...physics.base.jit import copy_into, kernel
 from ...physics.step import integrator
 from ..rest.equilibrium import ARMIJO, HALVINGS
 from ..skin import damping, potential
-from ..touch import ground
+from ..touch import drum, drums, ground
 from . import increment
 from .stepdata import ShellStep, Start, make_start
 
@@ -96,7 +96,7 @@ def search(method, st, sp, wk, e0):
     slope = abs(slope)
     model = st.problem.model
     rounding = 1e-13 * (model.absolute_pressure * model.rest_volume + abs(e0))
-    alpha = ground.max_step(x, dx, st.normals, st.heights)
+    alpha = min(ground.max_step(x, dx, st.normals, st.heights), drums.max_step(st.drums, x, dx))
     for _ in range(HALVINGS):
         for i in range(x.shape[0]):
             for c in range(3):
@@ -198,6 +198,7 @@ def lag_changed(st, sp, wk, weight):
     for i in range(wk.lam.shape[0]):
         for g in range(wk.lam.shape[1]):
             change = max(change, abs(wk.lam[i, g] - sp.lam[i, g]))
+    change = max(change, drums.lag_change(st.drums, wk.x, st.dhat, st.kappa))
     return change > LAG_TOL * weight
 
 
@@ -210,7 +211,7 @@ def step_kernel(method, st, x0, v0, a0, h):
     for i in range(x0.shape[0]):
         for c in range(3):
             wk.dx[i, c] = h * v0[i, c] + 0.5 * h * h * sp.a0[i, c]
-    alpha = ground.max_step(x0, wk.dx, st.normals, st.heights)
+    alpha = min(ground.max_step(x0, wk.dx, st.normals, st.heights), drums.max_step(st.drums, x0, wk.dx))
     for i in range(x0.shape[0]):
         for c in range(3):
             wk.x[i, c] = x0[i, c] + alpha * wk.dx[i, c]
@@ -218,6 +219,7 @@ def step_kernel(method, st, x0, v0, a0, h):
     frictional = False
     for g in range(st.mu.shape[0]):
         frictional |= st.mu[g] > 0.0
+    frictional |= drums.frictional(st.drums)
     newton_total = cg_total = envelope_total = 0
     for lag in range(FRICTION_LAGS + 1):
         matrices = lag == 0 or envelope_total > 0  # a later round starts from the last iterate's
@@ -230,6 +232,7 @@ def step_kernel(method, st, x0, v0, a0, h):
         if not frictional or lag == FRICTION_LAGS or not lag_changed(st, sp, wk, weight):
             break
         copy_into(sp.lam, wk.lam)
+        drums.accept_lag(st.drums)
     wk.force[:] = 0.0
     wk.trial_blocks[:] = 0.0
     increment.contact_gradient(st, sp, wk.x, wk.force, wk.trial_blocks, wk.u3)
@@ -250,6 +253,7 @@ def end_energy(st, x, v):
         for c in range(3):
             kinetic += 0.5 * p.model.mass[i] * v[i, c] * v[i, c]
     barrier = ground.barrier_energy(x, st.normals, st.heights, st.dhat, st.kappa)
+    barrier += drums.energy(st.drums, x, st.dhat, st.kappa)
     return kinetic + potential.energy(p.model, p.ws, x, p.loads) + barrier
 
 
@@ -319,6 +323,8 @@ def initial_acceleration(st: ShellStep, x: F64, v: F64) -> F64:
     grad = np.zeros_like(x)
     potential.gradient(p.model, p.ws, x, p.loads, grad)
     ground.add_barrier(x, st.normals, st.heights, st.dhat, st.kappa, grad, np.zeros((len(x), 3, 3)))
+    if st.drums is not None:
+        drum.add_barrier(x, st.drums, st.dhat, st.kappa, grad, np.zeros((len(x), 3, 3)), True)
     if st.damping > 0.0:
         basis, rate = np.zeros((6, len(x), 3)), np.zeros_like(x)
         damping.rigid_basis(x, p.model.mass, basis)

@@ -10,8 +10,9 @@ For a step of ``h`` (s) from ``x0``, ``v0``, ``a0`` (generalized-alpha's ``alpha
 
 ``x_a = x0 + c_x (x1 - x0)``, ``v_a = (1 - alpha_f) v1 + alpha_f v0``,
 ``y = x0 + h v0 + h^2 ((1/2 - beta) - alpha_m beta / (1 - alpha_m)) a0``; ``Pi`` the skin, gas and
-gravity (potential.py), ``B`` the grounds' barriers (ground.py; against the planes at the step's
-end, ``st.heights``), ``D`` friction (friction.py; on the slip relative to ``st.slide``), the
+gravity (potential.py), ``B`` the grounds' and drums' barriers (ground.py, drum.py; against the
+planes at the step's end, ``st.heights``), ``D`` friction (friction.py, drum_friction.py; on the slip
+relative to ``st.slide`` and to the drums' turn; touch/drums.py: none without drums), the
 damping's Rayleigh term (damping.py). Its Hessian (N/m) is
 ``c_M M + c_x K(x_a) + Hess (B + D) + c c_v (M - W W^T)``. The arrays are the records of
 stepdata.py (``st`` a ``ShellStep``, ``sp`` a ``Start``, ``wk`` a ``Work``).
@@ -25,7 +26,7 @@ from ..skin import damping, gas, potential
 from ..skin.bending import bending_hessians
 from ..solve import stepsolve
 from ..solve.blocks import assemble_hinges
-from ..touch import friction, ground
+from ..touch import drums, friction, ground
 
 BENDING_AGE = 8  # fresh assemblies that keep the hinges' matrices
 
@@ -44,6 +45,7 @@ def begin(method, st, x0, v0, a0, h, sp):
             sp.x0[i, c], sp.v0[i, c], sp.a0[i, c] = x0[i, c], v0[i, c], a
             sp.target[i, c] = x0[i, c] + h * v0[i, c] + h * h * shift * a
     ground.normal_forces(x0, st.normals, st.heights, st.dhat, st.kappa, sp.lam)
+    drums.begin(st.drums, x0, st.dhat, st.kappa)
     if st.damping > 0.0:
         damping.rigid_basis(x0, st.problem.model.mass, sp.basis)
     sp.coef[0], sp.coef[1], sp.coef[2], sp.coef[3] = h, c_m, c_x, c_v
@@ -79,12 +81,14 @@ def incremental(method, st, sp, x1, wk):
         for c in range(3):
             inertia += mass[i] * (x1[i, c] - sp.target[i, c]) ** 2
     total = 0.5 * c_m * inertia + ground.barrier_energy(x1, st.normals, st.heights, st.dhat, st.kappa)
+    total += drums.energy(st.drums, x1, st.dhat, st.kappa)
     if not math.isfinite(total):
         return total
     _force_point(sp, x1, wk.xa)
     total += potential.energy(p.model, p.ws, wk.xa, p.loads) / c_x
     e = st.slip_speed * sp.coef[0]
     total += friction.friction_energy(x1, sp.x0, st.normals, st.slide, sp.lam, st.mu, e, wk.u3)
+    total += drums.friction_energy(st.drums, x1, sp.x0, e)
     if st.damping > 0.0:
         kinematics(method, sp, x1, wk.a1, wk.v1, wk.va)
         damping.deformation_rate(wk.va, mass, sp.basis, wk.rate)
@@ -102,6 +106,7 @@ def contact_gradient(st, sp, x1, grad, blocks, u3):
     ground.add_barrier(x1, st.normals, st.heights, st.dhat, st.kappa, grad, blocks)
     e = st.slip_speed * sp.coef[0]
     friction.add_friction(x1, sp.x0, st.normals, st.slide, sp.lam, st.mu, e, grad, blocks, u3)
+    drums.add_contact(st.drums, x1, sp.x0, st.dhat, st.kappa, e, grad, blocks)
 
 
 @kernel

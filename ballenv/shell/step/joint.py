@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 from ...physics.base.jit import copy_into, kernel
 from ..rest.equilibrium import ARMIJO, HALVINGS
 from ..solve import jointcg, stepsolve
-from ..touch import broadphase, contact, ground
+from ..touch import broadphase, contact, drums, ground
 from . import implicit, increment
 from .jointdata import Joint
 from .stepdata import ShellStep
@@ -95,6 +95,7 @@ def max_step(sts, jt, x, dx):
     alpha = 1.0
     for k in range(len(sts)):
         alpha = min(alpha, ground.max_step(x[k], dx[k], sts[k].normals, sts[k].heights))
+        alpha = min(alpha, drums.max_step(sts[k].drums, x[k], dx[k]))
     return contact.max_step(cd.pairs, cd.n_pairs[0], flat(x), flat(dx), alpha, jt.scratch)
 
 
@@ -234,6 +235,7 @@ def _lags_changed(sts, jt):
     if changed:
         for k in range(len(sts)):
             copy_into(sts[k].start.lam, sts[k].work.lam)
+            drums.accept_lag(sts[k].drums)
     return changed
 
 
@@ -277,6 +279,7 @@ def step_kernel(method, sts, jt, x0, v0, a0, h):
     for k in range(len(sts)):
         for g in range(sts[k].mu.shape[0]):
             frictional |= sts[k].mu[g] > 0.0
+        frictional |= drums.frictional(sts[k].drums)
     newton_total = cg_total = 0
     for lag in range(implicit.FRICTION_LAGS + 1):
         status, iterations, cg_iterations = newton(method, sts, jt)

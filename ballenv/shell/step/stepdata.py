@@ -1,6 +1,6 @@
 """The records an implicit step of a shell reads and writes (SI units), built once per run:
-``ShellStep`` (the shell's model, its grounds, contact and damping constants, the linear solve's
-operator), ``Start`` (a step's data fixed at its start) and ``Work`` (the step's scratch), so that
+``ShellStep`` (the shell's model, its grounds and drums, contact and damping constants, the linear
+solve's operator), ``Start`` (a step's data fixed at its start) and ``Work`` (the step's scratch), so that
 the compiled step (implicit.py) allocates nothing."""
 
 from typing import NamedTuple
@@ -12,6 +12,7 @@ from ..rest.equilibrium import Problem
 from ..skin.model import ShellModel, build_workspace
 from ..solve import cg, envelope, stepsolve
 from ..solve.blocks import block_pattern
+from ..touch.drum import Drums
 
 F64 = NDArray[np.float64]
 
@@ -71,6 +72,7 @@ class ShellStep(NamedTuple):
     op: cg.Operator  # the Newton system's operator (stepsolve.py)
     start: Start
     work: Work
+    drums: Drums | None = None  # the drums (touch/drum.py), None without: no drum code is compiled
 
 
 def make_start(n_vertices: int, n_grounds: int, damped: bool) -> Start:
@@ -97,9 +99,10 @@ def make_step(
     grounds: tuple[F64, F64, F64, F64],
     contact: tuple[float, float, float],
     c: float,
+    drums: Drums | None = None,
 ) -> ShellStep:
     """The step data of ``model`` under ``gravity`` (3,) m/s^2, ``grounds`` (normals, heights, mu, slide),
-    ``contact`` (dhat m, kappa N/m, eps_v m/s) and damping ``c`` (1/s)."""
+    ``contact`` (dhat m, kappa N/m, eps_v m/s), damping ``c`` (1/s) and ``drums`` (or None)."""
     n, n_grounds = len(model.rest), len(grounds[1])
     loads = model.mass[:, None] * gravity[None, :]
     env = envelope.build_envelope(n, model.triangles, model.hinges)
@@ -110,5 +113,5 @@ def make_step(
     op = cg.make_operator(block_pattern(n, model.triangles, model.hinges), stepsolve.RANK)
     start, work = make_start(n, n_grounds, c > 0.0), make_work(n, n_grounds)
     return ShellStep(
-        problem, float(np.linalg.norm(gravity)), *grounds, *contact, c, owners, radius, op, start, work
+        problem, float(np.linalg.norm(gravity)), *grounds, *contact, c, owners, radius, op, start, work, drums
     )
