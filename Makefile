@@ -49,12 +49,11 @@ scenes: $(STAMP)
 # The replay viewer's browser test (tests/test_viewer.py) needs chromium on the PATH (Debian:
 # apt-get install chromium; .ci/run installs it); without it that test skips (fails under CI).
 # make test installs nothing outside .venv. pytest-xdist runs the test files on every core, each
-# file in one worker (its module fixtures built once) and the 3-D ball's files together in one
-# (one worker compiles its kernels; the groups: tests/conftest.py). A worker that dies is not
-# replaced: with --dist loadgroup, pytest-xdist 3.8 can wait forever for a replaced worker's
-# tests; without the replacement the run ends at once and names the test the worker died in.
+# file in one worker (its module fixtures built once). A worker that dies is not replaced: with
+# --dist loadfile, pytest-xdist 3.8 can wait forever for a replaced worker's tests; without the
+# replacement the run ends at once and names the test the worker died in.
 test: $(STAMP)
-	$(PY) -m pytest -q -n auto --dist loadgroup --max-worker-restart=0
+	$(PY) -m pytest -q -n auto --dist loadfile --max-worker-restart=0
 
 test-slow: $(STAMP)
 	$(PY) -m pytest -q -m slow
