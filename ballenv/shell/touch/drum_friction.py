@@ -23,6 +23,7 @@ import math
 
 from ...physics.base.jit import kernel
 from .drum import perpendicular
+from .friction import add_vertex, slope_over_slip, smoothed
 
 
 @kernel(inline="always")
@@ -58,8 +59,7 @@ def friction_energy(x, x0, drums, e):
         for i in range(x.shape[0]):
             if drums.lam[i, k] > 0.0:
                 y = _slip(x, x0, drums, i, k)
-                f0 = -y * y * y / (3.0 * e * e) + y * y / e + e / 3.0 if y < e else y
-                total += drums.mu[k] * drums.lam[i, k] * f0
+                total += drums.mu[k] * drums.lam[i, k] * smoothed(y, e)
     return total
 
 
@@ -74,16 +74,7 @@ def add_friction(x, x0, drums, e, grad, blocks):
             if drums.lam[i, k] <= 0.0:
                 continue
             y = _slip(x, x0, drums, i, k)
-            w = drums.mu[k] * drums.lam[i, k]
-            if y < e:
-                f1_y, uu = 2.0 / e - y / (e * e), -1.0 / (y * e * e) if y > 0.0 else 0.0
-            else:
-                f1_y, uu = 1.0 / y, -1.0 / (y * y * y)
-            for a in range(3):
-                grad[i, a] += w * f1_y * u[a]
-                for b in range(3):
-                    t_ab = (1.0 if a == b else 0.0) - n[a] * n[b]
-                    blocks[i, a, b] += w * (f1_y * t_ab + uu * u[a] * u[b])
+            add_vertex(grad, blocks, i, drums.mu[k] * drums.lam[i, k], y, e, u, n)
 
 
 @kernel
@@ -99,7 +90,7 @@ def friction_work(x, x0, drums, e):
             if drums.lam[i, k] <= 0.0:
                 continue
             y = _slip(x, x0, drums, i, k)
-            f1_y = (2.0 / e - y / (e * e)) if y < e else 1.0 / y
+            f1_y = slope_over_slip(y, e)
             for a in range(3):
                 total -= drums.mu[k] * drums.lam[i, k] * f1_y * u[a] * s[a]
     return total

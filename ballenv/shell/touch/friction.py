@@ -35,6 +35,34 @@ def _slip(x, x0, normals, slide, i, g, u):
     return math.sqrt(s)
 
 
+@kernel(inline="always")
+def smoothed(y, e):
+    """``f0(y)`` (m) of the module doc for a slip ``y`` (m) and smoothing ``e`` (m)."""
+    return -y * y * y / (3.0 * e * e) + y * y / e + e / 3.0 if y < e else y
+
+
+@kernel(inline="always")
+def slope_over_slip(y, e):
+    """``f1(y) / y`` (1/m) of the module doc."""
+    return (2.0 / e - y / (e * e)) if y < e else 1.0 / y
+
+
+@kernel(inline="always")
+def add_vertex(grad, blocks, i, w, y, e, u, n):
+    """Adds the gradient ``w f1 u / y`` (N) and Hessian (N/m) of ``w f0(|u|)`` (``w = mu lambda`` N,
+    ``u`` (3,) the slip m, ``y = |u|``, ``n`` (3,) the surface's unit normal) to vertex ``i``'s
+    entries of ``grad`` (V, 3) and ``blocks`` (V, 3, 3) (module doc)."""
+    if y < e:
+        f1_y, uu = 2.0 / e - y / (e * e), -1.0 / (y * e * e) if y > 0.0 else 0.0
+    else:
+        f1_y, uu = 1.0 / y, -1.0 / (y * y * y)
+    for a in range(3):
+        grad[i, a] += w * f1_y * u[a]
+        for b in range(3):
+            t_ab = (1.0 if a == b else 0.0) - n[a] * n[b]
+            blocks[i, a, b] += w * (f1_y * t_ab + uu * u[a] * u[b])
+
+
 @kernel
 def friction_energy(x, x0, normals, slide, lam, mu, e, u):
     """``sum D`` (J) over the vertex-ground pairs with ``lam[i, g] > 0``; ``u`` (3,) scratch."""
@@ -45,8 +73,7 @@ def friction_energy(x, x0, normals, slide, lam, mu, e, u):
         for i in range(x.shape[0]):
             if lam[i, g] > 0.0:
                 y = _slip(x, x0, normals, slide, i, g, u)
-                f0 = -y * y * y / (3.0 * e * e) + y * y / e + e / 3.0 if y < e else y
-                total += mu[g] * lam[i, g] * f0
+                total += mu[g] * lam[i, g] * smoothed(y, e)
     return total
 
 
@@ -60,16 +87,7 @@ def add_friction(x, x0, normals, slide, lam, mu, e, grad, blocks, u):
             if lam[i, g] <= 0.0:
                 continue
             y = _slip(x, x0, normals, slide, i, g, u)
-            w = mu[g] * lam[i, g]
-            if y < e:
-                f1_y, uu = 2.0 / e - y / (e * e), -1.0 / (y * e * e) if y > 0.0 else 0.0
-            else:
-                f1_y, uu = 1.0 / y, -1.0 / (y * y * y)
-            for a in range(3):
-                grad[i, a] += w * f1_y * u[a]
-                for b in range(3):
-                    t_ab = (1.0 if a == b else 0.0) - normals[g, a] * normals[g, b]
-                    blocks[i, a, b] += w * (f1_y * t_ab + uu * u[a] * u[b])
+            add_vertex(grad, blocks, i, mu[g] * lam[i, g], y, e, u, normals[g])
 
 
 @kernel
@@ -84,7 +102,7 @@ def friction_work(x, x0, normals, slide, lam, mu, e, u):
             if lam[i, g] <= 0.0:
                 continue
             y = _slip(x, x0, normals, slide, i, g, u)
-            f1_y = (2.0 / e - y / (e * e)) if y < e else 1.0 / y
+            f1_y = slope_over_slip(y, e)
             for a in range(3):
                 total -= mu[g] * lam[i, g] * f1_y * u[a] * slide[g, a]
     return total
