@@ -24,6 +24,7 @@ must start above every ground, on its side of every drum (at t = 0) and outside 
 """
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import NamedTuple
 
@@ -183,15 +184,18 @@ def _check_apart(scene: Scene, xs: F64, given: bool) -> None:
 
 
 class Recorder:
-    """The records of a run: every accepted step's end, or the multiples of ``output_dt``."""
+    """The records of a run: every accepted step's end, or the multiples of ``output_dt``; none if
+    not ``keep`` (a run driven piece by piece that reads its state instead)."""
 
-    def __init__(self, output_dt: float | None, steps: list[stepdata.ShellStep]) -> None:
-        self.output_dt, self.steps = output_dt, steps
+    def __init__(self, output_dt: float | None, steps: list[stepdata.ShellStep], keep: bool = True) -> None:
+        self.output_dt, self.steps, self.keep = output_dt, steps, keep
         self.rows: list[tuple[float, F64, F64, F64, F64, F64]] = []
         self.count = 0
 
     def add(self, t: float, x: F64, v: F64, force: F64, work: F64) -> None:
         """One record at ``t`` (s) (``work`` (shells,) J: the grounds' work so far)."""
+        if not self.keep:
+            return
         p = [
             gauge_pressure(st.problem.model, volume(x[k], st.problem.model.triangles))
             for k, st in enumerate(self.steps)
@@ -202,6 +206,8 @@ class Recorder:
     def step(self, t: float, h: float, before: tuple[F64, ...], after: tuple[F64, ...]) -> None:
         """Records for the accepted step ``[t, t + h]`` from its ends' ``(x, v, contact force,
         grounds' work)``."""
+        if not self.keep:
+            return
         if self.output_dt is None:
             self.add(t + h, *after)
             return
@@ -278,10 +284,18 @@ def next_step(scene: Scene, q: float, h: float, ratio: float) -> float:
 
 class Run:
     """A run's state between steps: positions, velocities, accelerations and contact forces
-    (shells, V, 3), the grounds' work on each shell (J), and what it has recorded; the grounds'
-    motion if one moves (else None), the drums' turning if one turns (else None)."""
+    (shells, V, 3), the grounds' work on each shell (J), and what it has recorded (nothing if not
+    ``record``); the grounds' motion if one moves (else None), the drums' turning if one turns (else
+    None)."""
 
-    def __init__(self, scene: Scene, x0: ArrayLike | None, v0: ArrayLike | None, output_dt: float | None):
+    def __init__(
+        self,
+        scene: Scene,
+        x0: ArrayLike | None,
+        v0: ArrayLike | None,
+        output_dt: float | None,
+        record: bool = True,
+    ):
         self.scene = scene
         self.method, self.steps = build(scene)
         touching = len(self.steps) > 1 or scene.self_contact
@@ -300,12 +314,16 @@ class Run:
         self.turning = turning.Turning(scene.drums, st.drums.turn) if turns and st.drums is not None else None
         g = np.array(scene.gravity_vector)
         self.up = -g / np.linalg.norm(g) if np.linalg.norm(g) > 0.0 else np.array([0.0, 0.0, 1.0])
-        self.recorder, self.stats = Recorder(output_dt, self.steps), SimulationStats()
+        self.recorder, self.stats = Recorder(output_dt, self.steps, record), SimulationStats()
         self.events: list[tuple[float, int, str, float]] = []
         self.recorder.add(0.0, self.x, self.v, self.force, self.work)
         self.ends = [self.end(k, self.x[k], self.v[k]) for k in range(len(self.steps))]
         self.budget = budget.energies(self.steps, self.x, self.v)
         self.sharing = budget.Sharing(len(self.steps))
+        self.control = control(self.method)
+        self.t, self.h = 0.0, scene.dt  # s: the time reached and the next step to try
+        # called as prepare(t, h) before each step [t, t + h] is tried (steering.py's gas ramps)
+        self.preparations: list[Callable[[float, float], None]] = []
 
     def end(self, k: int, x: F64, v: F64) -> tuple[float, float, float]:
         """Shell ``k``'s events.end at positions ``x`` and velocities ``v``, against the grounds
@@ -362,6 +380,53 @@ class Run:
         self.budget = [b + w for b, w in zip(self.budget, work, strict=True)]
         self.work = work1
 
+    def advance(self, t_end: float) -> None:
+        """Steps from ``self.t`` to ``t_end`` (s), landing on it (module doc's step control); a step
+        cut short to land there leaves the next try at least the step it was cut from, so that a run
+        advanced piece by piece steps as one advanced at once, apart from the landings."""
+        scene, ctl, clock = self.scene, self.control, time.perf_counter()
+        t, h = self.t, self.h
+        while t < t_end * (1.0 - 1e-12):
+            trial = min(h, t_end - t)
+            if self.motion is not None:
+                trial = self.motion.prepare(self.x, t, trial)
+            if self.turning is not None:
+                self.turning.prepare(t, trial)
+            for prepare in self.preparations:
+                prepare(t, trial)
+            try:
+                results = try_step(self.method, self.steps, (self.x, self.v, self.a), trial, self.contacts)
+            except implicit.StepFailure:
+                h = self.reject(t, 0.5 * trial, "the step was halved")
+                continue
+            a1 = np.array([r.a for r in results])
+            ratio = error_ratio(scene, ctl, self.steps, self.a, a1, trial) if scene.adaptive else 0.0
+            if ratio > 1.0:
+                h = self.reject(
+                    t, trial * max(SHRINK, 0.9 * ratio**-ctl.q), "the error control shrank the step"
+                )
+                continue
+            work = self.boundary_work(t, trial, results)
+            if not self.within_budget(results, work):
+                h = self.reject(t, 0.5 * trial, "the step gained energy; halved")
+                continue
+            self.accept(t, trial, results, work)
+            t += trial
+            self.t = t
+            cut = trial < h and t >= t_end * (1.0 - 1e-12)
+            h = (
+                max(h, next_step(scene, ctl.q, trial, ratio))
+                if cut
+                else next_step(scene, ctl.q, trial, ratio)
+            )
+        self.h = h
+        self.stats.wall_time += time.perf_counter() - clock
+
+    def trajectory(self) -> Trajectory:
+        """What the run has recorded so far."""
+        tt, xx, vv, ff, pp, ww = self.recorder.arrays()
+        return Trajectory(tt, xx, vv, ff, pp, sorted(self.events), self.stats, self.scene, ww)
+
     def reject(self, t: float, h: float, why: str) -> float:
         """Counts a rejected step; returns ``h`` (s), the next try, unless below ``dt_min``."""
         self.stats.rejections += 1
@@ -385,31 +450,5 @@ def simulate(
             f"output_dt = {output_dt!r} is out of range: must be None or a number in (0, t_end] s"
         )
     run = Run(scene, x0, v0, output_dt)
-    method, ctl = run.method, control(run.method)
-    t, h, clock = 0.0, scene.dt, time.perf_counter()
-    while t < t_end * (1.0 - 1e-12):
-        trial = min(h, t_end - t)
-        if run.motion is not None:
-            trial = run.motion.prepare(run.x, t, trial)
-        if run.turning is not None:
-            run.turning.prepare(t, trial)
-        try:
-            results = try_step(method, run.steps, (run.x, run.v, run.a), trial, run.contacts)
-        except implicit.StepFailure:
-            h = run.reject(t, 0.5 * trial, "the step was halved")
-            continue
-        a1 = np.array([r.a for r in results])
-        ratio = error_ratio(scene, ctl, run.steps, run.a, a1, trial) if scene.adaptive else 0.0
-        if ratio > 1.0:
-            h = run.reject(t, trial * max(SHRINK, 0.9 * ratio**-ctl.q), "the error control shrank the step")
-            continue
-        work = run.boundary_work(t, trial, results)
-        if not run.within_budget(results, work):
-            h = run.reject(t, 0.5 * trial, "the step gained energy; halved")
-            continue
-        run.accept(t, trial, results, work)
-        t += trial
-        h = next_step(scene, ctl.q, trial, ratio)
-    run.stats.wall_time = time.perf_counter() - clock
-    tt, xx, vv, ff, pp, ww = run.recorder.arrays()
-    return Trajectory(tt, xx, vv, ff, pp, sorted(run.events), run.stats, scene, ww)
+    run.advance(t_end)
+    return run.trajectory()
