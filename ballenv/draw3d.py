@@ -370,7 +370,8 @@ def fragments(xy: F64, width: int, height: int) -> tuple[I64, I64, F64]:
     """The pixels inside 2-D triangles ``xy`` (T, 3, 2) px: ``(triangle, pixel, weights)``, with
     ``pixel = row * width + column`` and the barycentric weights (N, 3) of the pixel's centre.
     Triangles are batched by the size of their bounding boxes so that each batch is one array."""
-    area = np.cross(xy[:, 1] - xy[:, 0], xy[:, 2] - xy[:, 0])
+    e, f = xy[:, 1] - xy[:, 0], xy[:, 2] - xy[:, 0]
+    area = e[:, 0] * f[:, 1] - e[:, 1] * f[:, 0]
     ok = np.all(np.isfinite(xy), axis=(1, 2)) & (np.abs(area) > 1e-12)
     ids = np.flatnonzero(ok)
     x0, y0, nx, ny = _boxes(xy[ids], width, height)
