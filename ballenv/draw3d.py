@@ -16,6 +16,7 @@ light. The background is a sky gradient. The same input gives the same array, bi
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 import pathlib
@@ -412,6 +413,9 @@ class Backdrop:
     ground: NDArray[np.int16]
 
 
+F32 = NDArray[np.float32]
+
+
 class Rays:
     """The camera's rays through the pixel centres, ray(i, j) = forward + u[j] right + v[i] up (unit
     depth), kept as the two separable offsets so that a ray's component along any vector is an
@@ -423,100 +427,137 @@ class Rays:
         self.v = ((0.5 * camera.height - np.arange(camera.height) - 0.5) / camera.focal).astype(np.float32)
         self.length = np.sqrt(1.0 + self.u[None, :] ** 2 + self.v[:, None] ** 2)  # (H, W)
 
-    def along(self, e: ArrayLike) -> NDArray[np.float32]:
+    def along(self, e: ArrayLike) -> F32:
         """The rays' components (H, W) along the vector ``e``."""
         e = np.asarray(e, dtype=np.float64)
         a, b, c = (np.float32(e @ axis) for axis in (self.forward, self.right, self.up))
         return (a + self.u[None, :] * b) + self.v[:, None] * c
 
 
-Planes = list[NDArray[np.float32]]  # an image's colour channels: three (H, W) arrays in [0, 1]
+def _rgb(colour: RGB, scale: float = 1.0) -> F64:
+    """``colour``'s channels times ``scale`` (0-255 for scale 1)."""
+    return np.asarray(colour, dtype=np.float64) * scale
 
 
-def _rgb(colour: RGB, scale: float = 1.0) -> list[np.float32]:
-    """``colour``'s channels in [0, 1] times ``scale``."""
-    return [np.float32(c * scale / 255.0) for c in colour]
+def _axes(normal: F64) -> tuple[F64, F64]:
+    """Two unit vectors spanning the plane of ``normal``: the checkerboard's axes."""
+    e1 = _unit(np.cross(normal, (1.0, 0.0, 0.0) if abs(normal[0]) < 0.9 else (0.0, 1.0, 0.0)))
+    return e1, np.cross(normal, e1)
 
 
-def _sky(rays: Rays, style: Style3D) -> Planes:
-    """The sky's colour channels: the horizon colour blending into the zenith colour with the square
-    root of the sine of the ray's elevation."""
+@dataclass
+class PlaneView:
+    """What the camera sees of one ground plane, whatever its eye's place along the plane: the
+    ``weight`` (H, W) of the plane's own colour (1 - fade where the plane is seen, else 0), the
+    offsets ``reach`` (3, H, W) m from the eye to the points seen, their coordinates ``q1``, ``q2``
+    (H, W) in tiles along the checkerboard's axes ``e1``, ``e2``, and the colour step ``step`` (3,)
+    (0-255, lit) from a light tile to a dark one, ``spot`` (3,) from a light tile to a spot."""
+
+    weight: F32
+    reach: F32
+    q1: F32
+    q2: F32
+    e1: F64
+    e2: F64
+    step: F64
+    spot: F64
+
+
+@dataclass
+class View:
+    """What a camera sees of the sky and the ground planes, except the planes' patterns: ``base``
+    (3, H, W), 0.5 plus the colour (0-255) with every plane's tiles light, the planes' ``PlaneView``s,
+    ``inv_depth`` and ``ground`` as in :class:`Backdrop`."""
+
+    base: F32
+    planes: list[PlaneView]
+    inv_depth: F64
+    ground: NDArray[np.int16]
+
+
+def _sky(rays: Rays, style: Style3D) -> F32:
+    """The sky's colour (3, H, W) 0-255: the horizon colour blending into the zenith colour with the
+    square root of the sine of the ray's elevation."""
     s = np.sqrt(np.clip(rays.along((0.0, 0.0, 1.0)) / rays.length, 0.0, 1.0))
-    return [h + s * (z - h) for h, z in zip(_rgb(style.horizon), _rgb(style.zenith), strict=True)]
+    h, z = _rgb(style.horizon).astype(np.float32), _rgb(style.zenith).astype(np.float32)
+    return h[:, None, None] + s * (z - h)[:, None, None]
 
 
-def _checker(
-    plane: Plane, rays: Rays, eye: F64, t: NDArray[np.float32], style: Style3D
-) -> NDArray[np.float32]:
-    """1 where the points ``eye + t ray`` on ``plane`` are on the checkerboard's dark squares, else 0."""
-    n = plane.normal
-    e1 = _unit(np.cross(n, (1.0, 0.0, 0.0) if abs(n[0]) < 0.9 else (0.0, 1.0, 0.0)))
-    e2 = np.cross(n, e1)
-    a = np.floor((np.float32(eye @ e1) + t * rays.along(e1)) * np.float32(1.0 / style.tile))
-    b = np.floor((np.float32(eye @ e2) + t * rays.along(e2)) * np.float32(1.0 / style.tile))
-    return ((a + b).astype(np.int32) & 1).astype(np.float32)
+def _plane_view(rays: Rays, plane: Plane, t: F32, seen: NDArray[np.bool_], style: Style3D) -> PlaneView:
+    """The :class:`PlaneView` of ``plane``, met at ray parameters ``t`` where ``seen``."""
+    t = np.where(seen, t, np.float32(0.0))
+    distance = t * rays.length
+    weight = np.where(seen, np.float32(style.fog) / (distance + np.float32(style.fog)), np.float32(0.0))
+    e1, e2 = _axes(plane.normal)
+    tile = np.float32(1.0 / style.tile)
+    reach = np.stack([t * rays.along(np.eye(3)[c]) for c in range(3)])
+    light = float(_lit(plane.normal, style))
+    floor0 = _rgb(style.floor[0], light)
+    return PlaneView(
+        weight, reach, t * rays.along(e1) * tile, t * rays.along(e2) * tile, e1, e2,
+        _rgb(style.floor[1], light) - floor0, _rgb(style.spot, light) - floor0,
+    )  # fmt: skip
 
 
-def _ring(spots: Sequence[Spot], rays: Rays, eye: F64, t: NDArray[np.float32]) -> NDArray[np.float32]:
-    """1 where the points ``eye + t ray`` are on one of the ``spots``' rings, else 0."""
-    out = np.zeros(t.shape, dtype=bool)
+@functools.lru_cache(maxsize=4)
+def _view(camera: Camera, grounds: tuple[tuple[Vec3, float], ...], style: Style3D) -> View:
+    """The :class:`View` of ``camera`` (its orientation and image; its target is the origin) over
+    ``grounds``, each given as (normal, the eye's height above it (m)). Cached: a camera that slides
+    along the ground sees the same view, only its patterns move."""
+    rays = Rays(camera)
+    depth = np.full((camera.height, camera.width), np.inf, dtype=np.float32)
+    ground = np.full(depth.shape, -1, dtype=np.int16)
+    base, views = _sky(rays, style), []
+    for k, (normal, above) in enumerate(grounds):
+        plane = Plane(np.asarray(normal), 0.0)
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            t = np.float32(-above) / rays.along(plane.normal)
+        seen = (t > NEAR) & (t < depth) if above > 0.0 else np.zeros(depth.shape, dtype=bool)
+        depth, ground = np.where(seen, t, depth), np.where(seen, np.int16(k), ground)
+        views.append(_plane_view(rays, plane, t, seen, style))
+        light = _rgb(style.floor[0], float(_lit(plane.normal, style)))
+        own = light[:, None, None] * views[-1].weight + _rgb(style.horizon)[:, None, None] * (
+            1 - views[-1].weight
+        )
+        base = np.where(seen, own.astype(np.float32), base)
+    inv = (np.float32(1.0) / depth).astype(np.float64)  # 0 for the sky (infinite depth)
+    view = View(base + np.float32(0.5), views, inv.reshape(-1), ground.reshape(-1))
+    for array in (view.base, view.inv_depth, view.ground, *(a for v in views for a in (v.weight, v.reach))):
+        array.flags.writeable = False  # shared by every frame of this view
+    return view
+
+
+def _ring(spots: Sequence[Spot], reach: F32, eye: F64) -> F32:
+    """1 where the points ``eye + reach`` are on one of the ``spots``' rings, else 0."""
+    out = np.zeros(reach.shape[1:], dtype=bool)
     for k, spot in enumerate(spots):
         radius = _real(f"spots[{k}] radius", spot.radius, 1e-6, 1e3, "a radius in (0, 1e3] m")
         width = _real(f"spots[{k}] width", spot.width, 1e-6, 1e3, "a line width in (0, 1e3] m")
-        d = eye - _vector3(f"spots[{k}] centre", spot.centre)
-        r2 = sum((np.float32(d[c]) + t * rays.along(np.eye(3)[c])) ** 2 for c in range(3))
+        d = (eye - _vector3(f"spots[{k}] centre", spot.centre)).astype(np.float32)
+        r2 = (d[0] + reach[0]) ** 2 + (d[1] + reach[1]) ** 2 + (d[2] + reach[2]) ** 2
         out |= (r2 <= radius**2) & (r2 >= max(radius - width, 0.0) ** 2)
     return out.astype(np.float32)
 
 
-def _ground(
-    plane: Plane, rays: Rays, eye: F64, t: NDArray[np.float32], spots: Sequence[Spot], style: Style3D
-) -> Planes:
-    """Lit checkerboard colour channels of the points ``eye + t ray`` on ``plane``, the spots drawn on
-    it, fading into the horizon colour with distance (half at ``style.fog``)."""
-    light = float(_lit(plane.normal, style))
-    dark = _checker(plane, rays, eye, t, style)
-    ring = _ring(spots, rays, eye, t) if spots else None
-    distance = t * rays.length
-    fade = distance / (distance + np.float32(style.fog))
-    out = []
-    for lt, dk, sp, hz in zip(
-        _rgb(style.floor[0], light),
-        _rgb(style.floor[1], light),
-        _rgb(style.spot, light),
-        _rgb(style.horizon),
-        strict=True,
-    ):
-        c = lt + dark * (dk - lt)
-        if ring is not None:
-            c += ring * (sp - c)
-        out.append(c + fade * (hz - c))
-    return out
-
-
 def backdrop(camera: Camera, grounds: Sequence[Plane], spots: Sequence[Spot], style: Style3D) -> Backdrop:
     """The sky and the ground planes as the camera sees them: each pixel shows the nearest plane its
-    ray meets in front of the camera, else the sky."""
-    rays, eye = Rays(camera), camera.position
-    depth = np.full((camera.height, camera.width), np.inf, dtype=np.float32)
-    ground = np.full(depth.shape, -1, dtype=np.int16)
-    colour = _sky(rays, style)
-    for k, plane in enumerate(grounds):
-        above = plane.normal @ eye - plane.height
-        if above <= 0.0:
-            continue
-        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            t = np.float32(-above) / rays.along(plane.normal)
-        seen = (t > NEAR) & (t < depth)
-        depth, ground = np.where(seen, t, depth), np.where(seen, np.int16(k), ground)
-        t = np.where(seen, t, np.float32(0.0))
-        colour = [
-            np.where(seen, g, c)
-            for g, c in zip(_ground(plane, rays, eye, t, spots, style), colour, strict=True)
-        ]
-    rgb = np.stack([(c * np.float32(255.0) + np.float32(0.5)).astype(np.uint8) for c in colour], axis=-1)
-    inv = (np.float32(1.0) / depth).astype(np.float64)  # 0 for the sky (infinite depth)
-    return Backdrop(rgb.reshape(-1, 3), inv.reshape(-1), ground.reshape(-1))
+    ray meets in front of the camera (checkered, spots on it, fading into the horizon colour with
+    distance, half at ``style.fog``), else the sky."""
+    eye = camera.position
+    key = tuple((tuple(float(c) for c in g.normal), float(g.normal @ eye - g.height)) for g in grounds)
+    view = _view(replace(camera, target=(0.0, 0.0, 0.0)), key, style)
+    colour = list(view.base)
+    for pv in view.planes:
+        a = np.floor(pv.q1 + np.float32(eye @ pv.e1 / style.tile))
+        b = np.floor(pv.q2 + np.float32(eye @ pv.e2 / style.tile))
+        dark = ((a + b).astype(np.int32) & 1).astype(np.float32) * pv.weight
+        ring = _ring(spots, pv.reach, eye) if spots else None
+        for c in range(3):
+            colour[c] = colour[c] + dark * np.float32(pv.step[c])
+            if ring is not None:  # a spot's colour instead of the tile's
+                colour[c] += ring * (pv.weight * np.float32(pv.spot[c]) - dark * np.float32(pv.step[c]))
+    rgb = np.stack([c.astype(np.uint8) for c in colour], axis=-1).reshape(-1, 3)
+    return Backdrop(rgb, view.inv_depth, view.ground)
 
 
 def _shadow(back: Backdrop, casters: F64, grounds: Sequence[Plane], camera: Camera, style: Style3D) -> None:
