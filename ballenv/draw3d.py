@@ -522,7 +522,8 @@ def _view(camera: Camera, grounds: tuple[tuple[Vec3, float], ...], style: Style3
         base = np.where(seen, own.astype(np.float32), base)
     inv = (np.float32(1.0) / depth).astype(np.float64)  # 0 for the sky (infinite depth)
     view = View(base + np.float32(0.5), views, inv.reshape(-1), ground.reshape(-1))
-    for array in (view.base, view.inv_depth, view.ground, *(a for v in views for a in (v.weight, v.reach))):
+    shared: list[NDArray[Any]] = [view.base, view.inv_depth, view.ground]
+    for array in shared + [a for v in views for a in (v.weight, v.reach, v.q1, v.q2)]:
         array.flags.writeable = False  # shared by every frame of this view
     return view
 
