@@ -154,7 +154,8 @@ class Style3D:
     light: the direction towards the (distant) light, any non-zero 3-vector; ambient, diffuse: the
     shares of the ambient and the directional light (a surface facing the light gets their sum);
     shadow: the share of the light left on a ground in a shadow; tile: the checkerboard's square (m);
-    fog: the distance (m) over which a ground fades by 1 - 1/e into the horizon colour.
+    fog: the distance (m) at which a ground has faded half way into the horizon colour; segments:
+    the triangles of a paddle's disc. Shares are in [0, 1], lengths in (0, 1e6] m.
     """
 
     light: Vec3 = (-0.45, -0.6, 1.0)
@@ -169,7 +170,18 @@ class Style3D:
     zenith: RGB = (118, 158, 212)
     spot: RGB = STYLE.target
     paddle: RGB = STYLE.paddle
-    segments: int = 32  # triangles of a paddle's disc
+    segments: int = 32
+
+    def __post_init__(self) -> None:
+        light = _vector3("Style3D light", self.light)
+        if not np.linalg.norm(light) > 0.0:
+            raise _fail("Style3D light", self.light, "a non-zero 3-vector")
+        for name in ("ambient", "diffuse", "shadow"):
+            _real(f"Style3D {name}", getattr(self, name), 0.0, 1.0, "a share in [0, 1]")
+        for name in ("tile", "fog"):
+            _real(f"Style3D {name}", getattr(self, name), 1e-9, 1e6, "a length in (0, 1e6] m")
+        if not (isinstance(self.segments, int) and 3 <= self.segments <= 4096):
+            raise _fail("Style3D segments", self.segments, "a whole number in [3, 4096]")
 
     def light_direction(self) -> F64:
         """The unit vector towards the light."""
@@ -501,7 +513,7 @@ def _plane_view(rays: Rays, plane: Plane, t: F32, seen: NDArray[np.bool_], style
 
 @functools.lru_cache(maxsize=4)
 def _view(camera: Camera, grounds: tuple[tuple[Vec3, float], ...], style: Style3D) -> View:
-    """The :class:`View` of ``camera`` (its orientation and image; its target is the origin) over
+    """The :class:`View` of ``camera`` (its orientation and image: its target and distance are unused) over
     ``grounds``, each given as (normal, the eye's height above it (m)). Cached: a camera that slides
     along the ground sees the same view, only its patterns move."""
     rays = Rays(camera)
@@ -546,7 +558,7 @@ def backdrop(camera: Camera, grounds: Sequence[Plane], spots: Sequence[Spot], st
     distance, half at ``style.fog``), else the sky."""
     eye = camera.position
     key = tuple((tuple(float(c) for c in g.normal), float(g.normal @ eye - g.height)) for g in grounds)
-    view = _view(replace(camera, target=(0.0, 0.0, 0.0)), key, style)
+    view = _view(replace(camera, target=(0.0, 0.0, 0.0), distance=1.0), key, style)
     colour = list(view.base)
     for pv in view.planes:
         a = np.floor(pv.q1 + np.float32(eye @ pv.e1 / style.tile))

@@ -223,3 +223,21 @@ def test_a_bad_camera_raises_a_value_error_naming_the_field(field, value):
 
 def test_the_default_style_lights_from_above():
     assert STYLE3D.light_direction()[2] > 0.5
+
+
+@pytest.mark.parametrize(
+    ("field", "value"), [("light", (0, 0, 0)), ("ambient", 1.5), ("tile", 0.0), ("segments", 2)]
+)
+def test_a_bad_style_raises_a_value_error_naming_the_field(field, value):
+    with pytest.raises(ValueError, match=f"Style3D {field}.*must be"):
+        Style3D(**{field: value})
+
+
+def test_a_camera_sliding_along_the_floor_sees_the_floor_pattern_move_with_it():
+    moved = Camera(target=(STYLE3D.tile, 0.0, 0.1), distance=1.0, elevation=0.3)  # one tile over
+    shifted = draw(moved, ball(CENTRE + (STYLE3D.tile, 0.0, 0.0)), TRIANGLES, FLOOR)
+    here = draw(CAMERA, ball(), TRIANGLES, FLOOR)
+    assert np.mean(np.any(shifted != here, axis=2)) > 0.3  # the checkerboard's parity flipped
+    twice = Camera(target=(2 * STYLE3D.tile, 0.0, 0.1), distance=1.0, elevation=0.3)
+    again = draw(twice, ball(CENTRE + (2 * STYLE3D.tile, 0.0, 0.0)), TRIANGLES, FLOOR)
+    assert np.mean(np.any(np.abs(again.astype(int) - here) > 2, axis=2)) < 0.01  # two tiles: the same
