@@ -379,7 +379,7 @@ def _boxes(xy: F64, width: int, height: int) -> tuple[I64, I64, I64, I64]:
     return lo[:, 0], lo[:, 1], n[:, 0], n[:, 1]
 
 
-def fragments(xy: F64, width: int, height: int) -> tuple[I64, I64, F64]:
+def _fragments(xy: F64, width: int, height: int) -> tuple[I64, I64, F64]:
     """The pixels inside 2-D triangles ``xy`` (T, 3, 2) px: ``(triangle, pixel, weights)``, with
     ``pixel = row * width + column`` and the barycentric weights (N, 3) of the pixel's centre.
     Triangles are batched by the size of their bounding boxes so that each batch is one array."""
@@ -552,7 +552,7 @@ def _ring(spots: Sequence[Spot], reach: F32, eye: F64) -> F32:
     return out.astype(np.float32)
 
 
-def backdrop(camera: Camera, grounds: Sequence[Plane], spots: Sequence[Spot], style: Style3D) -> Backdrop:
+def _backdrop(camera: Camera, grounds: Sequence[Plane], spots: Sequence[Spot], style: Style3D) -> Backdrop:
     """The sky and the ground planes as the camera sees them: each pixel shows the nearest plane its
     ray meets in front of the camera (checkered, spots on it, fading into the horizon colour with
     distance, half at ``style.fog``), else the sky."""
@@ -584,7 +584,7 @@ def _shadow(back: Backdrop, casters: F64, grounds: Sequence[Plane], camera: Came
         above = np.maximum(casters @ plane.normal - plane.height, 0.0)
         xy, depth = camera.project(casters - above[..., None] * (light / towards))
         xy = xy[np.all(depth > NEAR, axis=1)]
-        _, pixel, _ = fragments(xy, camera.width, camera.height)
+        _, pixel, _ = _fragments(xy, camera.width, camera.height)
         dark = np.zeros(len(back.ground), dtype=bool)
         dark[pixel] = True
         dark &= back.ground == k
@@ -597,7 +597,7 @@ def _paint(back: Backdrop, soup: Soup, camera: Camera) -> NDArray[np.uint8]:
     xy, depth = camera.project(soup.corners)
     front = np.all(depth > NEAR, axis=1)
     xy, inv, col = xy[front], 1.0 / depth[front], soup.colours[front]
-    tri, pixel, w = fragments(xy, camera.width, camera.height)
+    tri, pixel, w = _fragments(xy, camera.width, camera.height)
     z = np.einsum("nk,nk->n", w, inv[tri])
     zbuf = back.inv_depth.copy()
     np.maximum.at(zbuf, pixel, z)
@@ -637,7 +637,7 @@ def draw(
     x, tri = _check_mesh(positions, triangles)
     vals = None if values is None else _check_values(values, value_range, x.shape[:2])
     ground_planes = planes(grounds)
-    back = backdrop(camera, ground_planes, spots, style)
+    back = _backdrop(camera, ground_planes, spots, style)
     balls = _ball_soup(x, tri, _base_colours(x.shape[:2], vals, value_range, style), camera, smooth, style)
     pads = _paddle_soup(paddles, style)
     lit_faces = _face_normals(x, tri) @ style.light_direction() > 0.0

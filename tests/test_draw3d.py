@@ -241,3 +241,21 @@ def test_a_camera_sliding_along_the_floor_sees_the_floor_pattern_move_with_it():
     twice = Camera(target=(2 * STYLE3D.tile, 0.0, 0.1), distance=1.0, elevation=0.3)
     again = draw(twice, ball(CENTRE + (2 * STYLE3D.tile, 0.0, 0.0)), TRIANGLES, FLOOR)
     assert np.mean(np.any(np.abs(again.astype(int) - here) > 2, axis=2)) < 0.01  # two tiles: the same
+
+
+def test_per_vertex_values_colour_each_part_of_the_ball():
+    x = ball()
+    height = x[..., 2] - CENTRE[2]  # (1, V): per vertex, -0.1 to 0.1 m
+    image = draw(CAMERA, x, TRIANGLES, FLOOR, values=height, value_range=(-0.1, 0.1))
+    top = image[pixel(CAMERA, CENTRE + (0.0, -0.05, 0.07))].astype(int)
+    bottom = image[pixel(CAMERA, CENTRE + (0.0, -0.05, -0.07))].astype(int)
+    assert top[0] > top[2] and bottom[2] > bottom[0]
+
+
+def test_a_cached_view_draws_the_same_image_as_a_fresh_one():
+    from ballenv.draw3d import _view
+
+    _view.cache_clear()
+    fresh = draw(CAMERA, ball(), TRIANGLES, FLOOR, spots=[Spot((0.3, 0.0, 0.0))])
+    cached = draw(CAMERA, ball(), TRIANGLES, FLOOR, spots=[Spot((0.3, 0.0, 0.0))])
+    np.testing.assert_array_equal(fresh, cached)
