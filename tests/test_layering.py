@@ -24,7 +24,7 @@ SHELL_LAYERS = (
 )  # fmt: skip
 # the package's layers, lowest first (a top-level module or sub-package of ballenv, or agents)
 PACKAGE_LAYERS = (
-    ("ballenv.extras", "ballenv.files", "ballenv.draw", "ballenv.video", "ballenv.rules"),
+    ("ballenv.extras", "ballenv.files", "ballenv.draw", "ballenv.video", "ballenv.draw3d", "ballenv.rules"),
     ("ballenv.physics",),
     ("ballenv.shell",),
     ("ballenv.balls", "ballenv.controllers", "ballenv.cluster", "ballenv.envs"),
