@@ -27,7 +27,10 @@ document.getElementById("legend-hi").textContent = (pmax / 1e3).toFixed(1) + " k
 
 // the bounds of every vertex over the records: the camera's target and distance
 const lo = new THREE.Vector3(Infinity, Infinity, Infinity), hi = new THREE.Vector3(-Infinity, -Infinity, -Infinity);
-for (let i = 0; i < X.length; i += 3) { lo.min(new THREE.Vector3(X[i], X[i + 1], X[i + 2])); hi.max(new THREE.Vector3(X[i], X[i + 1], X[i + 2])); }
+for (let i = 0; i < X.length; i += 3) {
+  lo.x = Math.min(lo.x, X[i]); lo.y = Math.min(lo.y, X[i + 1]); lo.z = Math.min(lo.z, X[i + 2]);
+  hi.x = Math.max(hi.x, X[i]); hi.y = Math.max(hi.y, X[i + 1]); hi.z = Math.max(hi.z, X[i + 2]);
+}
 const centre = lo.clone().add(hi).multiplyScalar(0.5);
 const R = Math.max(...D.radius);
 const extent = Math.max(hi.clone().sub(lo).length(), 4 * R);
