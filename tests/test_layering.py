@@ -27,8 +27,8 @@ PACKAGE_LAYERS = (
     ("ballenv.extras", "ballenv.files", "ballenv.draw", "ballenv.video", "ballenv.draw3d", "ballenv.rules"),
     ("ballenv.physics",),
     ("ballenv.shell",),
-    ("ballenv.balls", "ballenv.controllers", "ballenv.cluster", "ballenv.envs"),
-    ("ballenv.viewer", "ballenv.scenes", "ballenv.clips", "ballenv.demo", "ballenv"),
+    ("ballenv.balls", "ballenv.controllers", "ballenv.cluster", "ballenv.envs", "ballenv.shell_files"),
+    ("ballenv.viewer", "ballenv.viewer3d", "ballenv.scenes", "ballenv.clips", "ballenv.demo", "ballenv"),
     ("agents",),
     ("train",),
 )

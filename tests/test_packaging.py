@@ -67,6 +67,21 @@ def test_the_wheel_marks_ballenv_as_typed(wheel):
     assert "ballenv/py.typed" in wheel.namelist()
 
 
+def test_the_wheel_holds_the_3d_viewers_assets_and_three_js_licence(wheel):
+    names = set(wheel.namelist())
+    for name in (
+        "viewer3d.js",
+        "three/three-orbit.min.js",
+        "three/LICENSE",
+        "three/VERSION",
+        "three/README.md",
+    ):
+        assert f"ballenv/assets/{name}" in names, name
+    licence = wheel.read("ballenv/assets/three/LICENSE").decode()
+    assert licence.startswith("The MIT License") and "three.js authors" in licence
+    assert wheel.read("ballenv/assets/three/VERSION").decode().strip() == "0.187.0"
+
+
 def test_the_wheel_holds_every_module_and_the_hyperparameter_files(wheel):
     names = set(wheel.namelist())
     for package in ("ballenv", "agents"):
@@ -96,6 +111,7 @@ def test_the_console_scripts_resolve_and_answer_help(wheel, capsys):
         "ballenv-evaluate",
         "ballenv-scenes",
         "ballenv-viewer",
+        "ballenv-viewer3d",
         "ballenv-compile",
     }
     for name, target in scripts.items():
@@ -123,7 +139,7 @@ def test_the_installed_wheel_runs_its_console_scripts_from_another_directory(whe
     )
     assert found.returncode == 0, found.stderr[-3000:]
     assert all(pathlib.Path(p).is_relative_to(target) for p in found.stdout.split()), found.stdout
-    for name in ("ballenv-train", "ballenv-evaluate", "ballenv-scenes", "ballenv-viewer"):
+    for name in ("ballenv-train", "ballenv-evaluate", "ballenv-scenes", "ballenv-viewer", "ballenv-viewer3d"):
         run = subprocess.run(
             [target / "bin" / name, "--help"], cwd=elsewhere, env=env, capture_output=True, text=True
         )

@@ -1,10 +1,6 @@
 """The replay page: self-contained, and it plays in a real headless browser (Debian's chromium)."""
 
 import json
-import os
-import shutil
-import subprocess
-import tempfile
 
 import numpy as np
 import pytest
@@ -13,16 +9,7 @@ from ballenv.draw import STYLE
 from ballenv.physics import Drum, Ground, Ring, Scene, Trajectory, simulate
 from ballenv.viewer import main, select_frames, write_html
 
-CHROMIUM_FLAGS = [
-    "--headless",
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-quic",
-    "--no-first-run",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-]
+from .browser import run_chromium
 
 
 @pytest.fixture(scope="module")
@@ -31,28 +18,6 @@ def saved(tmp_path_factory):
     scene = Scene(rings=[ring], grounds=[Ground(friction=0.5)], adaptive=True, dt=1e-2, impulse_tol=5e-3)
     traj = simulate(scene, 0.5, output_dt=5e-3)
     return traj, traj.save(tmp_path_factory.mktemp("viewer") / "drop.npz")
-
-
-def chromium():
-    """The chromium binary; missing, the test fails under CI (.ci/run installs it) and skips
-    elsewhere."""
-    exe = shutil.which("chromium") or shutil.which("chromium-browser")
-    if exe is None:
-        message = "chromium not found: install it (Debian: apt-get install chromium; .ci/run does)"
-        if os.environ.get("CI"):
-            pytest.fail(message)
-        pytest.skip(message)
-    return exe
-
-
-def run_chromium(*args):
-    with tempfile.TemporaryDirectory() as profile:
-        return subprocess.run(
-            [chromium(), *CHROMIUM_FLAGS, f"--user-data-dir={profile}", *args],
-            capture_output=True,
-            text=True,
-            timeout=60,
-        )
 
 
 def test_select_frames_keeps_ends_and_spreads_in_time():
