@@ -20,7 +20,8 @@ PHYSICS_LAYERS = (
 )  # fmt: skip
 # the 3-D ball's layers, lowest first, in the same way
 SHELL_LAYERS = (
-    "scene", "skin", "solve", "touch", "rest", "step", "simulation", "presets", "balls", "__init__",
+    "scene", "skin", "solve", "touch", "rest", "step", "simulation", "steering", "presets", "balls",
+    "__init__",
 )  # fmt: skip
 # the package's layers, lowest first (a top-level module or sub-package of ballenv, or agents)
 PACKAGE_LAYERS = (

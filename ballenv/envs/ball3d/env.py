@@ -4,7 +4,7 @@ a target spot."""
 from __future__ import annotations
 
 import copy
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import gymnasium as gym
 import numpy as np
@@ -12,12 +12,20 @@ from gymnasium import Env, spaces
 from gymnasium.utils import EzPickle
 from numpy.typing import ArrayLike, NDArray
 
-from ...extras import RENDER_NEEDS, render_modes, require_render_mode
+from ...extras import installed
 from ...shell.simulation import SimulationError
 from ..config import check_reset, parse_actions
 from . import observation
 from .ball import Ball
 from .config import ENV_NAME, Ball3DConfig
+
+if TYPE_CHECKING:
+    from .render import Ball3DRenderer
+
+
+def render_modes() -> list[str]:
+    """The render modes this installation can draw in: rgb_array (NumPy only), human with pygame-ce."""
+    return ["rgb_array", "human"] if installed("pygame") else ["rgb_array"]
 
 
 class InflatedBall3DEnv(Env[NDArray[np.float32], NDArray[np.float32]], EzPickle):
@@ -139,13 +147,11 @@ class InflatedBall3DEnv(Env[NDArray[np.float32], NDArray[np.float32]], EzPickle)
     def __init__(self, render_mode: str | None = None, **kwargs: Any) -> None:
         EzPickle.__init__(self, render_mode=render_mode, **kwargs)
         self.config = Ball3DConfig.from_kwargs(kwargs)
-        if render_mode is not None and render_mode not in RENDER_NEEDS:
+        if render_mode not in (None, "human", "rgb_array"):
             raise ValueError(
                 f"{ENV_NAME}.render_mode = {render_mode!r} is out of range: must be None, 'human' or "
                 "'rgb_array'"
             )
-        if render_mode is not None:
-            require_render_mode(render_mode)
         self.render_mode = render_mode
         low, high = observation.bounds(self.config)
         self.observation_space = spaces.Box(low, high, dtype=np.float32)
@@ -153,7 +159,11 @@ class InflatedBall3DEnv(Env[NDArray[np.float32], NDArray[np.float32]], EzPickle)
         self.action_space = spaces.Box(-1.0, 1.0, shape=(n_actions,), dtype=np.float32)
         self._structure = observation.structure(self.config.n_vertices, self.config.paddle)
         self.ball = Ball(self.config)
-        self._renderer: Any = None
+        self._renderer: Ball3DRenderer | None = None
+        if render_mode == "human":
+            from .render import Ball3DRenderer
+
+            Ball3DRenderer(self.config, "human", 1.0)  # what to install, now rather than at the first frame
         self._has_reset = False
         self.metadata = {**self.metadata, "render_fps": self.config.control_frequency}
 
@@ -208,7 +218,7 @@ class InflatedBall3DEnv(Env[NDArray[np.float32], NDArray[np.float32]], EzPickle)
             from .render import Ball3DRenderer
 
             self._renderer = Ball3DRenderer(self.config, self.render_mode, self.metadata["render_fps"])
-        return self._renderer.render(self.ball)  # type: ignore[no-any-return]
+        return self._renderer.render(self.ball)
 
     def close(self) -> None:
         if self._renderer is not None:

@@ -22,11 +22,29 @@ IDS = ("InflatedBall3D-v0", "InflatedBall3DPaddle-v0")
 
 
 @pytest.mark.parametrize("env_id", IDS)
-def test_gymnasium_check_env_passes_with_warnings_as_errors(env_id):
-    env = gym.make(env_id)
+@pytest.mark.parametrize("render_mode", [None, "rgb_array"])
+def test_gymnasium_check_env_passes_with_warnings_as_errors(env_id, render_mode):
+    env = gym.make(env_id, render_mode=render_mode)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        check_env(env.unwrapped, skip_render_check=True)
+        check_env(env.unwrapped, skip_render_check=False)
+
+
+def test_the_frame_of_a_resting_ball_shows_it_where_the_camera_looks():
+    env = gym.make(IDS[1], render_mode="rgb_array", start_height_range=(0.25, 0.26))
+    env.reset(seed=0)
+    for _ in range(60):  # it settles on the ground
+        env.step(np.array([-1.0, 0.0, 0.0]))
+    frame = env.render()
+    assert frame.shape == (360, 480, 3) and frame.dtype == np.uint8
+    ball = ball3d_env(env).ball
+    camera = ball3d_env(env)._renderer.camera
+    pixel, _ = camera.project(ball.sim.x[0].mean(axis=0))
+    col, row = (int(round(v)) for v in pixel)
+    colour = frame[row, col].astype(int)
+    corner = frame[5, 5].astype(int)  # sky
+    assert np.abs(colour - corner).sum() > 60  # the ball, not the sky, at its centre's pixel
+    assert np.array_equal(frame, env.render())  # drawing reads state only
 
 
 @pytest.mark.parametrize("env_id", IDS)
