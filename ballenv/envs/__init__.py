@@ -29,6 +29,7 @@ def register_envs() -> None:
             register(
                 id=env_id,
                 entry_point="ballenv.envs.ball3d.env:InflatedBall3DEnv",
+                vector_entry_point="ballenv.envs.ball3d.vector:Ball3DVectorEnv",
                 max_episode_steps=MAX_EPISODE_STEPS,
                 kwargs={"action_mode": mode},
             )

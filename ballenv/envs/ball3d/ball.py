@@ -10,6 +10,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ...shell import equilibrium
+from ...shell.simulation import SimulationError
 from ...shell.steering import Simulation
 from . import task
 from .config import Ball3DConfig
@@ -70,6 +71,16 @@ class Ball:
         self.impulse = np.zeros(3)
         self.end, self.failure, self.seen_events = "", "", 0
         self._assess()
+
+    def act(self, action: F64) -> None:
+        """One control step of ``action`` (clipped to [-1, 1]) unless the episode has ended; a
+        simulator failure ends it (:meth:`fail`) instead of raising."""
+        if self.end:
+            return
+        try:
+            self.step(action)
+        except (SimulationError, FloatingPointError, np.linalg.LinAlgError) as err:
+            self.fail(str(err))
 
     def step(self, action: F64) -> None:
         """One control step of ``action`` (clipped to [-1, 1])."""

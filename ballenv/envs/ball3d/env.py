@@ -13,7 +13,6 @@ from gymnasium.utils import EzPickle
 from numpy.typing import ArrayLike, NDArray
 
 from ...extras import installed
-from ...shell.simulation import SimulationError
 from ..config import check_reset, parse_actions
 from . import observation
 from .ball import Ball
@@ -191,11 +190,7 @@ class InflatedBall3DEnv(Env[NDArray[np.float32], NDArray[np.float32]], EzPickle)
         check_reset(self._has_reset, "step")
         n = 3 if self.config.paddle else 1
         a = np.clip(parse_actions(action, n, "step action"), -1.0, 1.0)
-        if self.ball.end == "":
-            try:
-                self.ball.step(a)
-            except (SimulationError, FloatingPointError, np.linalg.LinAlgError) as err:
-                self.ball.fail(str(err))
+        self.ball.act(a)
         if self.render_mode == "human":
             self.render()
         return self.ball.observe(), self.ball.reward[0], self.ball.end != "", False, self.ball.info()

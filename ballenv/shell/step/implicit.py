@@ -202,7 +202,7 @@ def lag_changed(st, sp, wk, weight):
     return change > LAG_TOL * weight
 
 
-@kernel
+@kernel(nogil=True)  # releases Python's lock: envs on threads step in parallel
 def step_kernel(method, st, x0, v0, a0, h):
     """One step of ``h`` (s) from ``(x0, v0, a0)`` into ``st.work`` (``x``, ``v1``, ``a1``,
     ``force``): ``(status, Newton iterations, CG iterations, envelope solves)`` (see :func:`step`)."""
