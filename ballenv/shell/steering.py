@@ -15,24 +15,24 @@ The pieces step as ``simulate`` does (simulation.py); a piece ends on the time a
   a ground or drum that is not touched add none.
 * **Carried acceleration.** Both settings change the forces at the current state, and the
   integrator's carried acceleration (generalized-alpha's ``a``) changes with them,
-  ``da_i = -(grad_i Pi_new - grad_i Pi_old) / m_i``: a step then starts consistent with the forces
+  ``da_i = -(grad_i Pi_new - grad_i Pi_old) / m_i`` (``(f_new - f_old)_i / m_i`` for the forces,
+  ``(p_new - p_old) (dV/dx_i) / m_i`` for the gas): a step then starts consistent with the forces
   it steps under, so the momentum of a held force is exact (a carried acceleration of the old
   forces would spread part of the change into the steps after it) and no step control sees a jump.
 * **Energy budget.** Both settings change the shell's energy at a fixed state by
-  ``dE = E(x, v; new) - E(x, v; old)`` (J), and the budget (step/budget.py) is credited with it. Over
+  ``dE = E(x, v; new) - E(x, v; old)`` (J: ``-(f_new - f_old) . x`` for the forces, ``U_new(V) -
+  U_old(V)`` for the gas), and the budget (step/budget.py) is credited with it. Over
   a force held from positions ``x0`` to ``x1``, the credits at its start and end sum to
   ``f . (x1 - x0)``: the work it did. For the gas, ``dE`` is the pump's work at the current shape.
 """
 
 import math
-from collections.abc import Callable
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .scene import Scene
 from .simulation import Run, Trajectory
-from .skin import potential
 from .skin.gas import gas_energy, gauge_pressure, volume, volume_gradient
 from .step import budget
 
@@ -166,7 +166,10 @@ class Simulation:
                 f"Simulation.set_forces.forces must be a finite array of shape {loads.shape} (N), "
                 f"got shape {f.shape}"
             )
-        self._credit(k, lambda: np.add(self.gravity_loads[k], f, out=loads))
+        change = f - (loads - self.gravity_loads[k])  # only the loads' term -f . x changes
+        self.run.budget[k] -= float(np.sum(change * self.x[k]))
+        self.run.a[k] += change / self.run.steps[k].problem.model.mass[:, None]
+        np.add(self.gravity_loads[k], f, out=loads)
 
     def energy(self, shell: int) -> float:
         """Energy of ``shell`` now (J): kinetic, skin, gas, gravity, external forces' and barriers'."""
@@ -176,21 +179,6 @@ class Simulation:
     def trajectory(self) -> Trajectory:
         """What has been recorded so far."""
         return self.run.trajectory()
-
-    def _credit(self, k: int, change: Callable[[], object]) -> None:
-        """Applies ``change`` to shell ``k``, credits its budget with the energy change and moves
-        its carried acceleration with the forces (module doc)."""
-        before, grad_before = self.energy(k), self._gradient(k)
-        change()
-        self.run.budget[k] += self.energy(k) - before
-        mass = self.run.steps[k].problem.model.mass
-        self.run.a[k] -= (self._gradient(k) - grad_before) / mass[:, None]
-
-    def _gradient(self, k: int) -> F64:
-        """``grad Pi`` of shell ``k`` now (V, 3) N: skin, gas, gravity and external forces."""
-        p, grad = self.run.steps[k].problem, np.zeros_like(self.x[k])
-        potential.gradient(p.model, p.ws, np.ascontiguousarray(self.x[k]), p.loads, grad)
-        return grad
 
     def _shell(self, shell: int) -> int:
         n = len(self.run.steps)
