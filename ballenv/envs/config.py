@@ -98,7 +98,7 @@ class BallEnvConfig:
         s(self, "arena_half_width", check_real(o, "arena_half_width", self.arena_half_width, 0.1, 1e4, "m"))
         s(self, "arena_height", check_real(o, "arena_height", self.arena_height, 0.1, 1e4, "m"))
         _check_wall(self)
-        s(self, "pressure_range", _range(o, "pressure_range", self.pressure_range, 0.0, 1e8, "Pa"))
+        s(self, "pressure_range", check_range(o, "pressure_range", self.pressure_range, 0.0, 1e8, "Pa"))
         _check_wall_holds(self, "pressure_range", self.pressure_range[1])
         ring = self.ring(self.pressure_range[1])
         s(self, "initial_pressure", check_real(o, "initial_pressure", self.initial_pressure, 0.0, 1e8, "Pa"))
@@ -112,7 +112,7 @@ class BallEnvConfig:
             )
         low = 2.0 * ring.radius  # the centre of a resting ball is about one (inflated) radius up
         for name in ("target_height_range", "start_height_range"):
-            s(self, name, _range(o, name, getattr(self, name), low, self.arena_height, "m"))
+            s(self, name, check_range(o, name, getattr(self, name), low, self.arena_height, "m"))
 
     @property
     def mode(self) -> int:
@@ -208,7 +208,7 @@ def _check_wall_holds(config: BallEnvConfig, name: str, pressure: float) -> None
         )
 
 
-def _range(owner: str, name: str, value: Any, low: float, high: float, unit: str) -> tuple[float, float]:
+def check_range(owner: str, name: str, value: Any, low: float, high: float, unit: str) -> tuple[float, float]:
     valid = f"a pair (low, high) of finite numbers with {low:g} <= low < high <= {high:g} {unit}"
     try:
         lo, hi = (float(v) for v in value)
@@ -219,9 +219,12 @@ def _range(owner: str, name: str, value: Any, low: float, high: float, unit: str
     return (lo, hi)
 
 
-def parse_actions(actions: ArrayLike, count: int, what: str) -> NDArray[np.float64]:
+def parse_actions(
+    actions: ArrayLike, count: int, what: str, owner: str = "InflatedBall-v3"
+) -> NDArray[np.float64]:
     """``actions`` as a float64 array of ``count`` finite numbers (any array of that size of real
-    numbers: ints or floats, not bools, strings or complex), else ValueError naming ``what``."""
+    numbers: ints or floats, not bools, strings or complex), else ValueError naming the env
+    ``owner`` and ``what``."""
     try:
         a = np.asarray(actions)
     except (TypeError, ValueError):  # ragged nesting
@@ -232,17 +235,17 @@ def parse_actions(actions: ArrayLike, count: int, what: str) -> NDArray[np.float
             return a
     shape = "(1,)" if count == 1 else f"({count}, 1)"
     raise ValueError(
-        f"InflatedBall-v3 {what} = {actions!r} is invalid: must be {count} finite real number"
+        f"{owner} {what} = {actions!r} is invalid: must be {count} finite real number"
         f"{'s' if count > 1 else ''} (shape {shape}; values outside [-1, 1] are clipped)"
     )
 
 
-def check_reset(has_reset: bool, call: str) -> None:
-    """Raise gymnasium's ``ResetNeeded`` if ``call`` ("step", "render", ...) comes before the first
-    reset: until then the ball has no state (its arrays are zeros)."""
+def check_reset(has_reset: bool, call: str, owner: str = "InflatedBall-v3") -> None:
+    """Raise gymnasium's ``ResetNeeded`` if ``call`` ("step", "render", ...) of the env ``owner``
+    comes before the first reset: until then the ball has no state."""
     if not has_reset:
         raise ResetNeeded(
-            f"InflatedBall-v3 {call}() was called before reset(): call reset() first, which places "
+            f"{owner} {call}() was called before reset(): call reset() first, which places "
             "the ball and draws the episode's target"
         )
 

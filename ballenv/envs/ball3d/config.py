@@ -10,7 +10,7 @@ from typing import Any
 from ...physics.scene import check_choice, check_real
 from ...shell import Ground, Scene, Shell
 from ...shell.presets import FIDELITY_PRESETS, with_fidelity
-from ..config import _range
+from ..config import check_range
 
 ENV_NAME = "InflatedBall3D-v0"
 ACTION_MODES = ("pressure", "paddle")
@@ -85,7 +85,7 @@ class Ball3DConfig:
     def _check_ball(self) -> None:
         """The ball's keywords through :class:`ballenv.shell.Shell`'s checks, named as the env's."""
         o, s = ENV_NAME, object.__setattr__
-        s(self, "pressure_range", _range(o, "pressure_range", self.pressure_range, -5e4, 1e7, "Pa"))
+        s(self, "pressure_range", check_range(o, "pressure_range", self.pressure_range, -5e4, 1e7, "Pa"))
         s(self, "initial_pressure", check_real(o, "initial_pressure", self.initial_pressure, -5e4, 1e7, "Pa"))
         if self.action_mode == "pressure" and not (
             self.pressure_range[0] <= self.initial_pressure <= self.pressure_range[1]
@@ -100,7 +100,7 @@ class Ball3DConfig:
             raise ValueError(str(err).replace("Shell.", f"{o}.", 1)) from None
         low = 2.0 * self.radius  # a resting ball's centre is about one radius up
         for name in ("target_height_range", "start_height_range"):
-            s(self, name, _range(o, name, getattr(self, name), low, self.arena_height, "m"))
+            s(self, name, check_range(o, name, getattr(self, name), low, self.arena_height, "m"))
 
     @property
     def paddle(self) -> bool:

@@ -187,9 +187,9 @@ class InflatedBall3DEnv(Env[NDArray[np.float32], NDArray[np.float32]], EzPickle)
         return self.ball.observe(), self.ball.info()
 
     def step(self, action: ArrayLike) -> tuple[NDArray[np.float32], float, bool, bool, dict[str, Any]]:
-        check_reset(self._has_reset, "step")
+        check_reset(self._has_reset, "step", ENV_NAME)
         n = 3 if self.config.paddle else 1
-        a = np.clip(parse_actions(action, n, "step action"), -1.0, 1.0)
+        a = np.clip(parse_actions(action, n, "step action", ENV_NAME), -1.0, 1.0)
         self.ball.act(a)
         if self.render_mode == "human":
             self.render()
@@ -208,7 +208,7 @@ class InflatedBall3DEnv(Env[NDArray[np.float32], NDArray[np.float32]], EzPickle)
     def render(self) -> NDArray[np.uint8] | None:
         if self.render_mode is None:
             return None
-        check_reset(self._has_reset, "render")
+        check_reset(self._has_reset, "render", ENV_NAME)
         if self._renderer is None:
             from .render import Ball3DRenderer
 

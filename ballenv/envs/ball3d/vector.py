@@ -109,9 +109,9 @@ class Ball3DVectorEnv(VectorEnv[NDArray[np.float32], NDArray[np.float32], NDArra
     ) -> tuple[
         NDArray[np.float32], NDArray[np.float64], NDArray[np.bool_], NDArray[np.bool_], dict[str, Any]
     ]:
-        check_reset(self._has_reset, "vector step")
+        check_reset(self._has_reset, "vector step", ENV_NAME)
         n = 3 if self.config.paddle else 1
-        a = np.clip(parse_actions(actions, self.num_envs * n, "vector step actions"), -1.0, 1.0)
+        a = np.clip(parse_actions(actions, self.num_envs * n, "vector step actions", ENV_NAME), -1.0, 1.0)
         a = a.reshape(self.num_envs, n)
         resetting = self._autoreset.copy()
 

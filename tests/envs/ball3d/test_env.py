@@ -158,8 +158,8 @@ def test_bad_input_is_a_clear_error():
     with pytest.raises(TypeError, match="unknown keyword"):
         gym.make(IDS[0], radious=0.1)
     env = gym.make(IDS[0])
-    with pytest.raises(ResetNeeded):
-        env.step(np.zeros(1))
+    with pytest.raises(ResetNeeded, match="InflatedBall3D-v0 step"):
+        env.unwrapped.step(np.zeros(1))
     env.reset(seed=0)
-    with pytest.raises(ValueError, match="step action"):
+    with pytest.raises(ValueError, match="InflatedBall3D-v0 step action"):
         env.step(np.array([np.nan]))
