@@ -73,10 +73,10 @@ def load_hyperparams(algo: str, mode: str, conf_file: str | None = None) -> dict
             names = sorted(f.stem for f in HYPERPARAMS.glob("*.yml"))
             raise UsageError(f"--conf-file = {conf_file!r}: no such file (the project's: {names})")
     table = yaml.safe_load(path.read_text()) or {}
-    if MODE_ENV_IDS[mode] not in table:
-        name = MODE_ENV_IDS[mode]
+    name = MODE_ENV_IDS[mode]
+    if name not in table:
         raise UsageError(f"{path} has no entry for {name} (--action-mode {mode}): {sorted(table)}")
-    return dict(table[MODE_ENV_IDS[mode]])
+    return dict(table[name])
 
 
 def task_env_kwargs(
