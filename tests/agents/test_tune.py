@@ -34,10 +34,11 @@ def test_heuristic_search_dry_run_leaves_the_file_alone(capsys):
     assert "best apex error" in capsys.readouterr().out
 
 
-def test_the_3d_dribbler_reads_its_tuned_parameters_in_range():
-    tuned = tuned_heuristic3d("paddle")
-    assert set(tuned) == set(HEURISTIC3D_SPACE["paddle"])
-    for name, (low, high, _) in HEURISTIC3D_SPACE["paddle"].items():
+@pytest.mark.parametrize("mode", ["pressure", "paddle"])
+def test_the_3d_controllers_tuned_parameters_are_in_range(mode):
+    tuned = tuned_heuristic3d(mode)
+    assert set(tuned) == set(HEURISTIC3D_SPACE[mode])
+    for name, (low, high, _) in HEURISTIC3D_SPACE[mode].items():
         assert low <= tuned[name] <= high
 
 
