@@ -1,5 +1,5 @@
 """agents.evaluate3d: the 3-D ball's height-and-spot errors per episode, reproducible, with missed
-apexes counted; and a PPO run of train.py on InflatedBall3DPaddle-v0 scored by it."""
+apexes counted; and PPO and SAC runs of train.py on InflatedBall3DPaddle-v0 scored by it."""
 
 import math
 
@@ -52,11 +52,18 @@ def test_the_pump_and_constant_gas_run_in_pressure_mode(capsys):
     )
 
 
-def test_ppo_trains_on_the_3d_paddle_and_its_best_model_scores(tmp_path, capsys):
+TINY = {
+    "ppo": '{"n_steps": 64, "batch_size": 64}',
+    "sac": '{"learning_starts": 64, "batch_size": 64, "buffer_size": 1000}',
+}
+
+
+@pytest.mark.parametrize("algo", ["ppo", "sac"])
+def test_an_agent_trains_on_the_3d_paddle_and_its_best_model_scores(algo, tmp_path, capsys):
     args = parse_args([
-        "--algo", "ppo", "--action-mode", "paddle3d", "--n-envs", "1", "--total-timesteps", "128",
+        "--algo", algo, "--action-mode", "paddle3d", "--n-envs", "1", "--total-timesteps", "128",
         "--eval-freq", "64", "--eval-episodes", "1", "--final-episodes", "1", "--log-dir", str(tmp_path),
-        "--env-kwargs", '{"max_episode_steps": 40}', "--hyperparams", '{"n_steps": 64, "batch_size": 64}',
+        "--env-kwargs", '{"max_episode_steps": 40}', "--hyperparams", TINY[algo],
     ])  # fmt: skip
     run = train(args)
     assert "python -m agents.evaluate3d" in capsys.readouterr().out  # no ring scoreboard for 3-D
