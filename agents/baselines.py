@@ -65,6 +65,7 @@ class ModelPolicy:
         require_signed(path, trust)  # a saved model is a pickle: only this user's runs, or --trust
         algo = algo or _algo_of(path)
         self.wrapper = _run_wrapper(path, env)
+        self.shape = env.action_space.shape or (1,)  # the env's action: (1,), or (3,) for the 3-D paddle
         classes: dict[str, type[PPO] | type[SAC]] = {"ppo": PPO, "sac": SAC}
         self.model = classes[algo].load(path, device="cpu")
         self.normalize = _normalization(path, trust)
@@ -90,7 +91,7 @@ class ModelPolicy:
         if self.normalize is not None:
             obs = self.normalize.apply(obs)
         action, _ = self.model.predict(obs, deterministic=True)
-        return np.asarray(action, dtype=np.float32).reshape(1)
+        return np.asarray(action, dtype=np.float32).reshape(self.shape)
 
 
 def _normalization(path: pathlib.Path, trust: bool) -> Normalization | None:

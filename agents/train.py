@@ -7,10 +7,16 @@
         --demonstrations runs/demonstrations_paddle.npz                   # cloned, then PPO
     python train.py --action-mode pressure --warm-start clone --demo-episodes 60 \
         --total-timesteps 2048 --final-episodes 30 --vec-env subproc     # make train: all in one
+    python train.py --algo ppo --action-mode paddle3d --total-timesteps 50000 --final-episodes 0
+                                                  # the 3-D ball: InflatedBall3DPaddle-v0
 
 Hyperparameters come from ``agents/hyperparams/{algo}.yml``, or ``--conf-file`` (one entry per env
 id, i.e. per action mode; the command line overrides the budget, the number of envs and the env
 keyword arguments).
+The 3-D ball's modes ("pressure3d", "paddle3d": InflatedBall3D-v0 and InflatedBall3DPaddle-v0)
+train the same way; their runs are scored by ``python -m agents.evaluate3d RUN`` (with
+``--final-episodes`` above 0, train says so and writes no scoreboard: the scoreboard's baselines
+are the ring's).
 ``--demonstrations`` pretrains a PPO policy on the privileged lookahead's demonstrations of a
 bounce-level task (``agents.imitation``) and evaluates it before the first update, so the best
 model may be the clone itself. ``--warm-start clone`` does it all in one command: it records the
@@ -64,7 +70,17 @@ if TYPE_CHECKING:
 from ballenv.files import write_text
 
 from . import checkpoints
-from .config import SUCCESS_TOLERANCE, UsageError, env_id, load_hyperparams, parse_env_kwargs, task_env_kwargs
+from .config import (
+    MODES,
+    SUCCESS_TOLERANCE,
+    UsageError,
+    env_id,
+    is_ball3d,
+    load_hyperparams,
+    mode_of,
+    parse_env_kwargs,
+    task_env_kwargs,
+)
 from .evaluate import DEFAULT_SEED, Score, evaluate
 from .imitation import TASKS, WRAPPERS, Demonstrations, pretrain, record_in_parallel
 from .normalization import save as save_normalization
@@ -82,7 +98,10 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--algo", choices=("ppo", "sac"), default="ppo", help="algorithm (default ppo)")
     p.add_argument(
-        "--action-mode", choices=("pressure", "paddle"), default="pressure", help="env action mode"
+        "--action-mode",
+        choices=MODES,
+        default="pressure",
+        help="env action mode (pressure3d, paddle3d: the 3-D ball)",
     )
     p.add_argument("--env-kwargs", type=parse_env_kwargs, default=None, help="JSON object of env keywords")
     p.add_argument(
@@ -192,13 +211,16 @@ def make_envs(
     training: bool = True,
     subproc: bool = False,
     wrapper: str | None = None,
+    mode: str | None = None,
 ) -> VecEnv:
+    """The vector env of the id of action mode ``mode`` (default: ``env_kwargs["action_mode"]``)."""
     from stable_baselines3.common.env_util import make_vec_env
     from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecNormalize
 
-    compile_once(env_kwargs)
+    mode = mode or env_kwargs["action_mode"]
+    compile_once(env_kwargs, mode)
     envs = make_vec_env(
-        env_id(env_kwargs["action_mode"]), n_envs=n_envs, seed=seed, env_kwargs=env_kwargs,
+        env_id(mode), n_envs=n_envs, seed=seed, env_kwargs=env_kwargs,
         wrapper_class=wrapper_class(wrapper),
         vec_env_cls=SubprocVecEnv if subproc and n_envs > 1 else DummyVecEnv,
         monitor_dir=None if monitor_dir is None else str(monitor_dir),
@@ -208,13 +230,14 @@ def make_envs(
     return envs
 
 
-def compile_once(env_kwargs: dict[str, Any]) -> None:
-    """Reset and step one env here, before any worker process starts: numba compiles the simulator
-    once (or loads it from its cache) and the workers load it from the cache instead of each
-    compiling it. Also the warm-up of a cluster's nodes (``ballenv.cluster.run_tasks``'s ``warm``)."""
+def compile_once(env_kwargs: dict[str, Any], mode: str | None = None) -> None:
+    """Reset and step one env (of action mode ``mode``, default ``env_kwargs["action_mode"]``) here,
+    before any worker process starts: numba compiles the simulator once (or loads it from its cache)
+    and the workers load it from the cache instead of each compiling it. Also the warm-up of a
+    cluster's nodes (``ballenv.cluster.run_tasks``'s ``warm``)."""
     import gymnasium as gym
 
-    env = gym.make(env_id(env_kwargs["action_mode"]), **env_kwargs)
+    env = gym.make(env_id(mode or env_kwargs["action_mode"]), **env_kwargs)
     env.reset(seed=0)
     env.step(env.action_space.sample())
     env.close()
@@ -525,12 +548,13 @@ def set_up(run: pathlib.Path, p: Plan, made_log_dir: bool) -> tuple[VecEnv, VecE
         torch.set_num_threads(1)
         envs = make_envs(
             p.env_kwargs, p.n_envs, a.seed, p.normalize, p.gamma, run / "monitor",
-            subproc=a.vec_env == "subproc", wrapper=p.wrapper,
+            subproc=a.vec_env == "subproc", wrapper=p.wrapper, mode=a.action_mode,
         )  # fmt: skip
         opened.callback(envs.close)
         eval_env = make_envs(
-            p.env_kwargs, 1, a.seed + 1000, p.normalize, p.gamma, training=False, wrapper=p.wrapper
-        )
+            p.env_kwargs, 1, a.seed + 1000, p.normalize, p.gamma, training=False, wrapper=p.wrapper,
+            mode=a.action_mode,
+        )  # fmt: skip
         opened.callback(eval_env.close)
         if a.resume:
             model = checkpoints.load(run, p.cls, envs)
@@ -587,7 +611,9 @@ def train(args: argparse.Namespace, on_evaluation: OnEvaluation | None = None) -
     unit = "bounces" if p.wrapper in TASKS else "env steps"  # a bounce-level task's step is a bounce
     print(f"trained {args.algo} for {model.num_timesteps} {unit} in {wall:.0f} s "
           f"({wall / model.num_timesteps * 1e5:.0f} s per 100k {unit}); run folder {run}")  # fmt: skip
-    if args.final_episodes > 0:
+    if args.final_episodes > 0 and is_ball3d(args.action_mode):
+        print(f"no scoreboard for the 3-D ball: score the run with  python -m agents.evaluate3d {run}")
+    elif args.final_episodes > 0:
         score(run, args, p.env_kwargs, phases, f"{model.num_timesteps} {unit}", began)
     return run
 
@@ -648,8 +674,9 @@ def resumed(args: argparse.Namespace) -> tuple[argparse.Namespace, dict[str, Any
         "env_wrapper": config["env_wrapper"], "n_envs": config["n_envs"],
         "n_timesteps": config["total_timesteps"], "env_kwargs": config["env_kwargs"],
     }  # fmt: skip
+    mode = mode_of(config.get("env_id", "")) or config["env_kwargs"]["action_mode"]  # 3-D: from the id
     new = argparse.Namespace(**{
-        **vars(args), "algo": config["algo"], "action_mode": config["env_kwargs"]["action_mode"],
+        **vars(args), "algo": config["algo"], "action_mode": mode,
         "env_kwargs": config["env_kwargs"], "seed": config["seed"], "n_envs": config["n_envs"],
         "total_timesteps": config["total_timesteps"], "eval_freq": config["eval_freq"],
         "eval_episodes": config["eval_episodes"], "vec_env": config["vec_env"],

@@ -1,6 +1,7 @@
 """Tune with Optuna: the scripted controllers' parameters, or PPO's hyperparameters.
 
     python -m agents.tune heuristic --action-mode pressure --trials 60
+    python -m agents.tune heuristic3d --action-mode paddle --trials 30 --episodes 5 --max-episode-steps 400
     python -m agents.tune ppo --action-mode paddle --trials 12 --timesteps 100000 [train.py options]
     python -m agents.tune ppo --trials 12 --ray local --parallel 2     # trials as Ray tasks
 
@@ -12,6 +13,11 @@ seeds; the held-out seeds of ``agents.evaluate`` (10,000 on) stay unseen.
   ``env_kwargs`` of ``hyperparams/ppo.yml``). The best is written to
   ``agents/hyperparams/heuristic.yml`` under the env id, where ``agents.policies.HeuristicPolicy``
   reads it (``--dry-run``: print it only).
+* ``heuristic3d``: the 3-D ball's controller (:data:`HEURISTIC3D_SPACE`; paddle mode:
+  ``ballenv.controllers.PaddleDribble3D``); objective the mean combined height-and-spot error of
+  ``agents.evaluate3d`` over ``--episodes`` episodes seeded 0, 1, ... of ``--max-episode-steps``
+  control steps; the best is written to ``heuristic.yml`` under the 3-D env id, where
+  ``agents.policies.Heuristic3DPolicy`` reads it.
 * ``ppo``: the hyperparameters of :func:`sample_ppo` (the ranges of RL Baselines3 Zoo's PPO
   sampler, narrowed to this budget); each trial trains ``--timesteps`` env steps with
   ``agents.train``, its periodic evaluations (mean return over 5 episodes) feed Optuna's median
@@ -48,7 +54,8 @@ from ballenv.files import write_text
 
 from .config import HEURISTIC_PARAMS, heuristic_table, load_hyperparams, task_env_kwargs
 from .evaluate import evaluate
-from .policies import HeuristicPolicy
+from .evaluate3d import evaluate3d
+from .policies import Heuristic3DPolicy, HeuristicPolicy
 from .train import ROOT, OnEvaluation, add_cluster_argument, compile_once, train
 from .train import parse_args as train_args
 
@@ -63,6 +70,19 @@ HEURISTIC_SPACE = {
         "floor": (-0.3, 0.1, False),  # smallest amplitude
     },
     "paddle": {"retention": (0.5, 0.95, False)},  # fraction of a bounce's energy kept
+}
+HEURISTIC3D_SPACE = {
+    "paddle": {
+        "retention": (0.7, 0.99, False),  # fraction of the energy above rest a strike and bounce keep
+        "carry": (0.3, 1.0, False),  # fraction of the horizontal velocity a bounce keeps
+        "spot_gain": (0.2, 1.5, False),  # share of the offset to the spot covered by the next strike
+    },
+    "pressure": {
+        "landing_height": (0.13, 0.4, False),  # m: pump from this height of the centre on the way down
+        "gain": (0.05, 2.0, True),
+        "bias": (0.0, 0.5, False),
+        "floor": (-0.3, 0.1, False),
+    },
 }
 
 
@@ -86,11 +106,12 @@ class HeuristicTrial:
     env_kwargs: dict[str, Any]
 
 
-def sample_heuristic(trial: optuna.Trial, mode: str) -> dict[str, float]:
-    """The controller parameters of one trial in action mode ``mode`` (:data:`HEURISTIC_SPACE`)."""
+def sample_heuristic(trial: optuna.Trial, mode: str, space: dict[str, Any] | None = None) -> dict[str, float]:
+    """The controller parameters of one trial in action mode ``mode`` (of ``space``, default
+    :data:`HEURISTIC_SPACE`)."""
     return {
         name: trial.suggest_float(name, low, high, log=log)
-        for name, (low, high, log) in HEURISTIC_SPACE[mode].items()
+        for name, (low, high, log) in (space or HEURISTIC_SPACE)[mode].items()
     }
 
 
@@ -137,15 +158,47 @@ def tune_heuristic(args: argparse.Namespace) -> optuna.Study:
     if not args.dry_run:
         from ballenv.envs import ENV_IDS
 
-        table = heuristic_table()
-        table[ENV_IDS[args.action_mode]] = best
-        header = (
-            "# The scripted controllers' parameters, tuned by `python -m agents.tune heuristic` (Optuna\n"
-            "# TPE, mean apex error over training seeds), one entry per env id; read by\n"
-            "# agents.policies.HeuristicPolicy.\n"
-        )
-        write_text(HEURISTIC_PARAMS, header + yaml.safe_dump(table, sort_keys=True))
-        print(f"wrote {HEURISTIC_PARAMS}")
+        write_heuristic(ENV_IDS[args.action_mode], best)
+    return study
+
+
+def write_heuristic(env_id: str, params: dict[str, float]) -> None:
+    """Store ``params`` under ``env_id`` in ``hyperparams/heuristic.yml`` (the other entries kept)."""
+    table = heuristic_table()
+    table[env_id] = params
+    header = (
+        "# The scripted controllers' parameters, tuned by `python -m agents.tune heuristic` (Optuna\n"
+        "# TPE, mean apex error over training seeds) and, for the 3-D ids, `python -m agents.tune\n"
+        "# heuristic3d` (the combined height-and-spot error of agents.evaluate3d), one entry per env\n"
+        "# id; read by agents.policies.HeuristicPolicy and Heuristic3DPolicy.\n"
+    )
+    write_text(HEURISTIC_PARAMS, header + yaml.safe_dump(table, sort_keys=True))
+    print(f"wrote {HEURISTIC_PARAMS}")
+
+
+def tune_heuristic3d(args: argparse.Namespace) -> optuna.Study:
+    """Tune the 3-D ball's controller (module doc: ``heuristic3d``), serially."""
+    import optuna
+
+    from ballenv.envs import BALL3D_ENV_IDS
+
+    study = optuna.create_study(direction="minimize", sampler=optuna.samplers.TPESampler(seed=args.seed))
+    env_kwargs = {"action_mode": args.action_mode, "max_episode_steps": args.max_episode_steps}
+
+    def objective(trial: optuna.Trial) -> float:
+        params = sample_heuristic(trial, args.action_mode, HEURISTIC3D_SPACE)
+        score = evaluate3d(lambda env: Heuristic3DPolicy(env, params), env_kwargs, args.episodes, seed=0)
+        trial.set_user_attr("height_error", float(np.mean(score.height_errors)))
+        trial.set_user_attr("spot_distance", float(np.mean(score.spot_distances)))
+        return float(np.mean(score.combined_errors))
+
+    study.optimize(objective, n_trials=args.trials)
+    for t in study.trials:
+        print(f"trial {t.number}: combined {t.value:.4f} {t.user_attrs} {t.params}")
+    best = {k: round(float(v), 4) for k, v in study.best_params.items()}
+    print(f"best combined error {study.best_value:.4f} over {args.episodes} training episodes: {best}")
+    if not args.dry_run:
+        write_heuristic(BALL3D_ENV_IDS[args.action_mode], best)
     return study
 
 
@@ -307,14 +360,17 @@ def _current_ppo(mode: str) -> dict[str, Any]:
 def build_parser() -> argparse.ArgumentParser:
     """The command line of ``python -m agents.tune`` (arguments it does not know go to agents.train)."""
     p = argparse.ArgumentParser(prog="python -m agents.tune", description=__doc__.split("\n")[0])
-    p.add_argument("what", choices=("heuristic", "ppo"), help="what to tune")
+    p.add_argument("what", choices=("heuristic", "heuristic3d", "ppo"), help="what to tune")
     p.add_argument("--action-mode", choices=("pressure", "paddle"), default="pressure")
     p.add_argument("--trials", type=int, default=40, help="Optuna trials")
     p.add_argument("--episodes", type=int, default=20, help="heuristic: training episodes per trial")
     p.add_argument("--timesteps", type=int, default=100_000, help="ppo: env steps per trial")
+    p.add_argument(
+        "--max-episode-steps", type=int, default=300, help="heuristic3d: the episodes' time limit (steps)"
+    )
     p.add_argument("--seed", type=int, default=0, help="sampler seed (ppo: trial k trains with seed + k)")
     p.add_argument("--out", type=pathlib.Path, default=pathlib.Path("runs/tune"), help="ppo: output folder")
-    p.add_argument("--dry-run", action="store_true", help="heuristic: print the best, do not write it")
+    p.add_argument("--dry-run", action="store_true", help="heuristic(3d): print the best, do not write it")
     add_cluster_argument(p, "the trials (asked and told in batches, not pruned)")
     p.add_argument(
         "--parallel", type=positive_int, default=None,
@@ -339,6 +395,8 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
     in ``train_args``."""
     parser = build_parser()
     args, rest = parser.parse_known_args(argv)
+    if args.what == "heuristic3d" and args.cluster is not None:
+        parser.error("heuristic3d runs its trials one by one: --ray is for heuristic and ppo")
     if args.parallel is not None and args.cluster is None:
         parser.error(f"--parallel {args.parallel} needs --ray (without it the trials run one by one)")
     args.train_args = rest  # ppo: goes to agents.train
@@ -347,7 +405,8 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
 
 def main(argv: Sequence[str] | None = None) -> None:
     args = parse_args(argv)
-    (tune_heuristic if args.what == "heuristic" else tune_ppo)(args)
+    tuners = {"heuristic": tune_heuristic, "heuristic3d": tune_heuristic3d, "ppo": tune_ppo}
+    tuners[args.what](args)
 
 
 if __name__ == "__main__":

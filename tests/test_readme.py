@@ -71,6 +71,12 @@ def check_evaluate(args):
     build_parser().parse_args(args)
 
 
+def check_evaluate3d(args):
+    from agents.evaluate3d import build_parser
+
+    build_parser().parse_args(args)
+
+
 def check_imitation(args):
     from agents.imitation import parse_args
 
@@ -133,6 +139,7 @@ def checker(argv):
         ("make",): check_make,
         ("python", "train.py"): check_train,
         ("python", "-m", "agents.evaluate"): check_evaluate,
+        ("python", "-m", "agents.evaluate3d"): check_evaluate3d,
         ("python", "-m", "agents.study"): check_study_or_tune(agents.study),
         ("python", "-m", "agents.tune"): check_study_or_tune(agents.tune),
         ("python", "-m", "agents.imitation"): check_imitation,

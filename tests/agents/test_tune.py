@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 import yaml
 
-from agents.config import HEURISTIC_PARAMS, tuned_heuristic
+from agents.config import HEURISTIC_PARAMS, tuned_heuristic, tuned_heuristic3d
 from agents.evaluate import evaluate
 from agents.policies import HeuristicPolicy
-from agents.tune import HEURISTIC_SPACE, main, parse_args, tell, tune_heuristic, tune_ppo
+from agents.tune import HEURISTIC3D_SPACE, HEURISTIC_SPACE, main, parse_args, tell, tune_heuristic, tune_ppo
 
 SHORT = {"max_episode_steps": 60}
 
@@ -32,6 +32,25 @@ def test_heuristic_search_dry_run_leaves_the_file_alone(capsys):
     main(["heuristic", "--action-mode", "paddle", "--trials", "2", "--episodes", "1", "--dry-run"])
     assert HEURISTIC_PARAMS.read_text() == before
     assert "best apex error" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("mode", ["pressure", "paddle"])
+def test_the_3d_controllers_tuned_parameters_are_in_range(mode):
+    tuned = tuned_heuristic3d(mode)
+    assert set(tuned) == set(HEURISTIC3D_SPACE[mode])
+    for name, (low, high, _) in HEURISTIC3D_SPACE[mode].items():
+        assert low <= tuned[name] <= high
+
+
+def test_the_3d_heuristic_search_dry_run_scores_trials_and_leaves_the_file_alone(capsys):
+    before = HEURISTIC_PARAMS.read_text()
+    argv = ["heuristic3d", "--action-mode", "paddle", "--trials", "2", "--episodes", "1"]
+    main([*argv, "--max-episode-steps", "40", "--dry-run"])
+    assert HEURISTIC_PARAMS.read_text() == before
+    out = capsys.readouterr().out
+    assert "best combined error" in out and "spot_distance" in out
+    with pytest.raises(SystemExit):
+        parse_args([*argv, "--ray", "local"])
 
 
 def test_ppo_search_trains_trials_and_writes_the_best_in_zoo_format(tmp_path):
