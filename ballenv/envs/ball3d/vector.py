@@ -3,8 +3,9 @@
 ``gym.make_vec("InflatedBall3DPaddle-v0", num_envs=8)`` (the ids' default vectorisation). Env ``i``
 uses the random stream of a single env reset with ``seed + i`` (as ``SyncVectorEnv`` seeds its envs)
 and the same steps, so it reproduces single envs to the bit, whatever the thread count. The
-simulator's implicit step releases Python's lock, so ``num_threads`` threads step their envs in
-parallel (the rest of a control step, the env's Python, runs one thread at a time). Autoreset
+simulator's implicit step releases Python's lock, so ``num_threads`` threads may overlap in it
+(the rest of a control step, the env's Python, runs one thread at a time;
+``benchmarks/results/env3d_throughput.md`` has what two threads gain). Autoreset
 follows Gymnasium's default ``NEXT_STEP`` mode: the step after an episode ends resets that env,
 ignores its action and returns the first observation of the new episode with reward 0.
 
