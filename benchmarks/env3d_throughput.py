@@ -32,7 +32,7 @@ RESULTS = pathlib.Path(__file__).parent / "results"
 CASES = (("InflatedBall3D-v0", "pressure"), ("InflatedBall3DPaddle-v0", "paddle"))
 RING = {"pressure": "InflatedBall-v3", "paddle": "InflatedBallPaddle-v3"}
 TARGET = 1000.0  # env steps/s at 162 vertices, fast preset
-VECTOR_ENVS = 4
+VECTOR_ENVS = 8
 SWEEP_RTOLS = (1e-3, 3e-3, 1e-2, 3e-2)  # the fast preset's, and looser
 SWEEP_STEPS = 300
 

@@ -116,18 +116,19 @@ class Ball3DVectorEnv(VectorEnv[NDArray[np.float32], NDArray[np.float32], NDArra
         a = a.reshape(self.num_envs, n)
         resetting = self._autoreset.copy()
 
-        def advance(rows: range) -> None:
-            for i in rows:
-                if resetting[i]:
-                    self.balls[i].reset(self._rngs[i])
-                else:
-                    self.balls[i].act(a[i])
+        def advance(i: int) -> None:
+            if resetting[i]:
+                self.balls[i].reset(self._rngs[i])
+            else:
+                self.balls[i].act(a[i])
 
-        chunks = [range(k, self.num_envs, self.num_threads) for k in range(self.num_threads)]
+        # one task per env, taken by whichever thread is free: a ball in contact takes many short
+        # steps while one in flight takes one, so fixed shares would leave a thread idle
         if self._pool is None:
-            advance(chunks[0])
+            for i in range(self.num_envs):
+                advance(i)
         else:
-            list(self._pool.map(advance, chunks))
+            list(self._pool.map(advance, range(self.num_envs)))
         stepped = ~resetting
         terminated = np.array([b.end != "" for b in self.balls]) & stepped
         truncated = np.array([b.steps >= self.max_episode_steps for b in self.balls]) & stepped
