@@ -13,7 +13,12 @@ import contextlib
 import os
 import pathlib
 import tempfile
+import zipfile
 from collections.abc import Iterator
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
 
 
 def _default_mode() -> int:
@@ -58,3 +63,33 @@ def write_bytes(path: str | os.PathLike[str], data: bytes) -> pathlib.Path:
     with atomic_path(path) as tmp:
         tmp.write_bytes(data)
     return pathlib.Path(path)
+
+
+def npz_headers(
+    path: pathlib.Path, archive: zipfile.ZipFile, owner: str
+) -> dict[str, tuple[tuple[int, ...], np.dtype[Any]]]:
+    """Shape and dtype of each ``.npy`` member of the ``.npz`` ``archive`` at ``path``, read from its
+    header (a few bytes decompressed) before any array is; ``ValueError`` naming ``owner`` (the
+    loader) for a member that is not a ``.npy`` array of format version 1.0 or 2.0."""
+    out = {}
+    for name in archive.namelist():
+        if not name.endswith(".npy"):
+            raise ValueError(f"{owner}: {path} holds {name!r}, not a .npy array")
+        with archive.open(name) as member:
+            version = np.lib.format.read_magic(member)
+            if version not in ((1, 0), (2, 0)):
+                raise ValueError(f"{owner}: {path}: {name} has .npy version {version}")
+            read = (
+                np.lib.format.read_array_header_1_0
+                if version == (1, 0)
+                else np.lib.format.read_array_header_2_0
+            )
+            shape, _, dtype = read(member)
+        out[name[: -len(".npy")]] = (tuple(int(n) for n in shape), dtype)
+    return out
+
+
+def npz_member(archive: zipfile.ZipFile, key: str) -> NDArray[Any]:
+    """The array ``key`` of the ``.npz`` ``archive`` (its header already checked), without pickles."""
+    with archive.open(key + ".npy") as member:
+        return np.lib.format.read_array(member, allow_pickle=False)

@@ -44,7 +44,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from .files import atomic_path
+from .files import atomic_path, npz_headers, npz_member
 from .shell.scene import Drum, Ground, Scene, Shell
 from .shell.simulation import SimulationStats, Trajectory
 
@@ -146,11 +146,11 @@ def load(path: str | os.PathLike[str], max_bytes: int = MAX_LOAD_BYTES) -> Traje
 
 def _load(path: pathlib.Path, max_bytes: int) -> Trajectory:
     with zipfile.ZipFile(path) as archive:
-        headers = _headers(path, archive)
+        headers = npz_headers(path, archive, "shell_files.load")
         _check_records(path, archive, headers)
         scene, stats = _records(path, archive)
         _check_arrays(path, headers, scene, max_bytes)
-        arrays = {k: _member(archive, k) for k in ARRAYS}
+        arrays = {k: npz_member(archive, k) for k in ARRAYS}
     table = arrays.pop("event_table")
     kinds, shells = table[:, 2], table[:, 1]
     bad_kind = ~np.isin(kinds, np.arange(len(EVENT_KINDS)))
@@ -158,28 +158,6 @@ def _load(path: pathlib.Path, max_bytes: int) -> Trajectory:
         raise ValueError(f"shell_files.load: {path}: event_table rows name unknown event kinds or shells")
     events = [(float(t), int(k), EVENT_KINDS[int(c)], float(z)) for t, k, c, z in table]
     return Trajectory(events=events, stats=stats, scene=scene, **arrays)
-
-
-def _headers(
-    path: pathlib.Path, archive: zipfile.ZipFile
-) -> dict[str, tuple[tuple[int, ...], np.dtype[Any]]]:
-    """Shape and dtype of each ``.npy`` member, read from its header (a few bytes decompressed)."""
-    out = {}
-    for name in archive.namelist():
-        if not name.endswith(".npy"):
-            raise ValueError(f"shell_files.load: {path} holds {name!r}, not a .npy array")
-        with archive.open(name) as member:
-            version = np.lib.format.read_magic(member)
-            if version not in ((1, 0), (2, 0)):
-                raise ValueError(f"shell_files.load: {path}: {name} has .npy version {version}")
-            read = (
-                np.lib.format.read_array_header_1_0
-                if version == (1, 0)
-                else np.lib.format.read_array_header_2_0
-            )
-            shape, _, dtype = read(member)
-        out[name[: -len(".npy")]] = (tuple(int(n) for n in shape), dtype)
-    return out
 
 
 def _check_records(path: pathlib.Path, archive: zipfile.ZipFile, headers: dict[str, Any]) -> None:
@@ -192,13 +170,13 @@ def _check_records(path: pathlib.Path, archive: zipfile.ZipFile, headers: dict[s
             raise ValueError(f"shell_files.load: {path}: {key} must be a string, not {headers[key]}")
         if key in headers and headers[key][1].itemsize // 4 > MAX_RECORD_CHARS:
             raise ValueError(f"shell_files.load: {path}: {key} is longer than {MAX_RECORD_CHARS} characters")
-    if str(_member(archive, "format")) != FORMAT:
+    if str(npz_member(archive, "format")) != FORMAT:
         raise ValueError(f"shell_files.load: {path} is not a shell trajectory (format is not {FORMAT!r})")
     if "version" in missing or headers["version"] != ((), np.dtype(np.int64)):
         raise ValueError(
             f"shell_files.load: {path} has no int64 layout version, this ballenv reads {VERSION}"
         )
-    version = int(_member(archive, "version"))
+    version = int(npz_member(archive, "version"))
     if version != VERSION:
         raise ValueError(
             f"shell_files.load: {path} has layout version {version}, this ballenv reads {VERSION}"
@@ -210,8 +188,8 @@ def _check_records(path: pathlib.Path, archive: zipfile.ZipFile, headers: dict[s
 def _records(path: pathlib.Path, archive: zipfile.ZipFile) -> tuple[Scene, SimulationStats]:
     """The scene (validated by its constructors) and the statistics."""
     try:
-        scene = scene_from_dict(json.loads(str(_member(archive, "scene"))))
-        fields = json.loads(str(_member(archive, "stats")))
+        scene = scene_from_dict(json.loads(str(npz_member(archive, "scene"))))
+        fields = json.loads(str(npz_member(archive, "stats")))
         if not isinstance(fields, dict) or set(fields) != {
             f.name for f in dataclasses.fields(SimulationStats)
         }:
@@ -251,9 +229,3 @@ def _check_arrays(path: pathlib.Path, headers: dict[str, Any], scene: Scene, max
         raise ValueError(
             f"shell_files.load: {path} declares {total} bytes of arrays, more than max_bytes = {max_bytes}"
         )
-
-
-def _member(archive: zipfile.ZipFile, key: str) -> NDArray[Any]:
-    """The array ``key`` of the archive (its header already checked), without pickles."""
-    with archive.open(key + ".npy") as member:
-        return np.lib.format.read_array(member, allow_pickle=False)

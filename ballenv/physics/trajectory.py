@@ -43,7 +43,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..files import atomic_path
+from ..files import atomic_path, npz_headers, npz_member
 from .base.layout import EVENT_APEX, EVENT_HEIGHT, EVENT_KIND, EVENT_RING, EVENT_T
 from .build import build_barrier_workspace, build_model, build_ring_contact_workspace
 from .effects.assembly import ENERGY_PARTS, ring_energy
@@ -282,11 +282,11 @@ def load(path: str | os.PathLike[str], max_bytes: int = MAX_LOAD_BYTES) -> Traje
 
 def _load(path: pathlib.Path, max_bytes: int) -> Trajectory:
     with zipfile.ZipFile(path) as archive:
-        headers = _headers(path, archive)
+        headers = npz_headers(path, archive, "Trajectory.load")
         _check_records(path, archive, headers)
         scene, stats = _records(path, archive)
         _check_arrays(path, headers, scene, max_bytes)
-        arrays = {k: _member(archive, k) for k in ARRAYS}
+        arrays = {k: npz_member(archive, k) for k in ARRAYS}
     table = arrays["event_table"]
     kinds, rings = table[:, 2], table[:, 1]
     if np.any((kinds < 0) | (kinds >= len(EVENT_KINDS))) or np.any((rings < 0) | (rings >= len(scene.rings))):
@@ -305,28 +305,6 @@ def _load(path: pathlib.Path, max_bytes: int) -> Trajectory:
     )
 
 
-def _headers(
-    path: pathlib.Path, archive: zipfile.ZipFile
-) -> dict[str, tuple[tuple[int, ...], np.dtype[Any]]]:
-    """Shape and dtype of each ``.npy`` member, read from its header (a few bytes decompressed)."""
-    out = {}
-    for name in archive.namelist():
-        if not name.endswith(".npy"):
-            raise ValueError(f"Trajectory.load: {path} holds {name!r}, not a .npy array")
-        with archive.open(name) as member:
-            version = np.lib.format.read_magic(member)
-            if version not in ((1, 0), (2, 0)):
-                raise ValueError(f"Trajectory.load: {path}: {name} has .npy version {version}")
-            read = (
-                np.lib.format.read_array_header_1_0
-                if version == (1, 0)
-                else np.lib.format.read_array_header_2_0
-            )
-            shape, _, dtype = read(member)
-        out[name[: -len(".npy")]] = (tuple(int(n) for n in shape), dtype)
-    return out
-
-
 def _check_records(path: pathlib.Path, archive: zipfile.ZipFile, headers: dict[str, Any]) -> None:
     """The format, version, scene and statistics records: present, scalar, of their types, bounded."""
     missing = [k for k in ("format", "version", *ARRAYS, "scene", "stats") if k not in headers]
@@ -337,11 +315,11 @@ def _check_records(path: pathlib.Path, archive: zipfile.ZipFile, headers: dict[s
             raise ValueError(f"Trajectory.load: {path}: {key} must be a string, not {headers[key]}")
         if key in headers and headers[key][1].itemsize // 4 > MAX_RECORD_CHARS:
             raise ValueError(f"Trajectory.load: {path}: {key} is longer than {MAX_RECORD_CHARS} characters")
-    if str(_member(archive, "format")) != FORMAT:
+    if str(npz_member(archive, "format")) != FORMAT:
         raise ValueError(f"Trajectory.load: {path} is not a ballenv trajectory (format is not {FORMAT!r})")
     if "version" in missing or headers["version"] != ((), np.dtype(np.int64)):
         raise ValueError(f"Trajectory.load: {path} has no int64 layout version, this ballenv reads {VERSION}")
-    version = int(_member(archive, "version"))
+    version = int(npz_member(archive, "version"))
     if version != VERSION:
         raise ValueError(
             f"Trajectory.load: {path} has layout version {version}, this ballenv reads {VERSION}"
@@ -353,8 +331,8 @@ def _check_records(path: pathlib.Path, archive: zipfile.ZipFile, headers: dict[s
 def _records(path: pathlib.Path, archive: zipfile.ZipFile) -> tuple[Scene, dict[str, Any]]:
     """The scene (validated by ``Scene`` itself) and the statistics' fields."""
     try:
-        scene = scene_from_dict(json.loads(str(_member(archive, "scene"))))
-        stats = json.loads(str(_member(archive, "stats")))
+        scene = scene_from_dict(json.loads(str(npz_member(archive, "scene"))))
+        stats = json.loads(str(npz_member(archive, "stats")))
         if not isinstance(stats, dict) or set(stats) != {f.name for f in dataclasses.fields(SimulationStats)}:
             raise ValueError("the statistics' fields are not SimulationStats'")
         SimulationStats(**{**stats, "effects": tuple(stats["effects"])})
@@ -388,9 +366,3 @@ def _check_arrays(path: pathlib.Path, headers: dict[str, Any], scene: Scene, max
         raise ValueError(
             f"Trajectory.load: {path} declares {total} bytes of arrays, more than max_bytes = {max_bytes}"
         )
-
-
-def _member(archive: zipfile.ZipFile, key: str) -> NDArray[Any]:
-    """The array ``key`` of the archive (its header already checked), without pickles."""
-    with archive.open(key + ".npy") as member:
-        return np.lib.format.read_array(member, allow_pickle=False)
