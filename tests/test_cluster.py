@@ -47,6 +47,7 @@ def cluster(local_ray):
     return "local"
 
 
+@pytest.mark.slow  # 30 s of soak scenes; the scene grid on Ray below tests the same path to the bit
 def test_the_soak_on_ray_tallies_as_the_serial_run(cluster):
     soak = load_benchmark("soak")
     serial, serial_lost, _ = soak.soak_scenes(12, seed=0)

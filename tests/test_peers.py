@@ -50,6 +50,7 @@ def test_main_without_pyelastica_says_how_to_install_it(monkeypatch, capsys):
     assert peers.INSTALL_HINT in capsys.readouterr().err
 
 
+@pytest.mark.slow  # 40 s compiling PyElastica's own kernels; benchmarks/peers.py runs the same
 def test_pyelastica_first_apex_matches_ballenv():
     pytest.importorskip("elastica", reason=f"pyelastica is not installed ({peers.INSTALL_HINT})")
     label, setting = peers.ELASTICA_SETTINGS[0]
@@ -59,6 +60,7 @@ def test_pyelastica_first_apex_matches_ballenv():
     assert result.steps == round(peers.T_END / setting["dt"])
 
 
+@pytest.mark.slow  # as above: PyElastica's kernels
 @pytest.mark.parametrize(("fraction", "holds"), [(0.95, True), (1.02, False)])
 def test_pyelastica_stable_step_limit_is_the_estimate(fraction, holds):
     # the estimate is 2.09e-5 s at G = E/3: 5 % below it the ring holds, 2 % above it blows apart

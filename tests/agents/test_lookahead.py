@@ -114,6 +114,7 @@ def test_the_response_analysis_finds_the_crossing_the_slope_and_an_exact_fit():
     assert pump_response.residual_sd(np.array([0.1, 0.1, 0.2, 0.2]), features[:, :0]) == 0.05
 
 
+@pytest.mark.slow  # 50 s of network fits inside benchmarks/pump_response.py's analysis
 def test_the_network_fit_finds_a_dependence_no_linear_fit_finds():
     """``pump_response.network_residual_sd`` out of sample on a target that depends on its input
     through the fractional part of a multiple of it (as the right amplitude does on the landing

@@ -73,6 +73,7 @@ def test_a_tiny_study_runs_end_to_end(tmp_path, capsys):
     assert rows[0]["episodes"] == 6 and rows[1]["episodes"] == 3
 
 
+@pytest.mark.slow  # a minute of PPO on Ray; the serial study above and test_cluster's Ray grid stay
 def test_seeds_trained_as_ray_tasks_give_the_serial_results(tmp_path, local_ray):
     """Two seeds with two envs each (one process per env, as the serial run) trained as Ray tasks:
     the same held-out scores, learning curves and table as one after the other in this process."""

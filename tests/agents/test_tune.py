@@ -66,6 +66,7 @@ def test_ppo_search_trains_trials_and_writes_the_best_in_zoo_format(tmp_path):
     assert evaluations["timesteps"].size >= 1
 
 
+@pytest.mark.slow  # 30-55 s of PPO trials; the heuristic's trials on Ray above test the same path
 def test_ppo_trials_as_ray_tasks_equal_the_serial_search(tmp_path, local_ray):
     """Two trials (the file's values, then the first sampled) asked together and trained as Ray
     tasks: the same hyperparameters, evaluations and best entry as the serial search."""

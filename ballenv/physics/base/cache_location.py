@@ -4,11 +4,13 @@ numba keys a cached kernel on its own file only: after an edit or an upgrade tha
 in another file (a callee it inlined), the old machine code would still load and run. So the cache
 of ``ballenv`` lives in a folder named by a hash of every source file of the packages that hold
 kernels (``ballenv.physics``, ``ballenv.envs`` and ``ballenv.shell``), numba's version and Python's
-(:func:`source_key`): different code, a different folder, never a stale kernel (two checkouts of the
-same code share the folder, not the kernels: numba names them by the source file's full path). The
-folder sits under the first writable of ``NUMBA_CACHE_DIR`` (if set),
-``$XDG_CACHE_HOME/ballenv/numba`` (by default ``~/.cache/ballenv/numba``, 0700) and a private folder
-in the system's temporary directory (said once); with none writable, every run compiles (said once).
+(:func:`source_key`): different code, a different folder, never a stale kernel. Inside it a kernel's
+files sit at its module's path within the package (:class:`PackageLocator`), not at a hash of the
+file's absolute path as numba would put them, so every checkout, clone or install of the same sources
+loads the same kernels: only new sources compile. The folder sits under the first writable of
+``NUMBA_CACHE_DIR`` (if set), ``$XDG_CACHE_HOME/ballenv/numba`` (by default
+``~/.cache/ballenv/numba``, 0700) and a private folder in the system's temporary directory (said
+once); with none writable, every run compiles (said once).
 Of the folders under the same parent, the ``KEEP`` most recently used are kept, and older ones
 removed once unused for ``IDLE`` seconds (a process of another version may still be running
 from a folder it opened earlier: its kernels are never deleted under it).
@@ -31,7 +33,7 @@ import time
 from collections.abc import Callable
 
 import numba
-from numba.core import config
+from numba.core import caching, config
 
 from .compile_lock import private_dir
 from .compile_notice import log_info
@@ -44,6 +46,35 @@ KEY = re.compile(r"[0-9a-f]{16}")
 MOVED = "no writable cache folder in %s: numba's cache of the simulator goes to %s"
 SEEDED = "numba's cache of the simulator in %s is read-only: its kernels are copied to %s"
 NONE = "no writable folder for numba's cache of the simulator: every run compiles"
+
+
+try:
+    from numba.core.caching import UserProvidedCacheLocator as _UserLocator
+except ImportError:  # older numba names it with a leading underscore
+    from numba.core.caching import _UserProvidedCacheLocator as _UserLocator  # type: ignore[attr-defined,no-redef]
+
+_LOCATORS = caching.CacheImpl._locator_classes  # numba's locators, tried in order for each function
+
+
+class PackageLocator(_UserLocator):
+    """numba's cache locator for a kernel of this package: its files in ``config.CACHE_DIR`` (the
+    folder of these sources, :func:`choose`) under its module's folder relative to the package
+    (``physics/step``, ...). numba still checks each file's own stamp before it loads a kernel: a
+    hash of the file in numba 0.68; its time and size in older releases, which a new checkout
+    changes (there a new checkout compiles)."""
+
+    def __init__(self, py_func, py_file):
+        super().__init__(py_func, py_file)
+        folder = pathlib.Path(py_file).resolve().parent.relative_to(PACKAGE)
+        self._cache_path = os.path.join(config.CACHE_DIR, *folder.parts)
+
+    @classmethod
+    def from_function(cls, py_func, py_file):
+        """The locator of ``py_func`` if ``py_file`` lies in this package and a cache folder is
+        set, else None (numba's own locators then place it)."""
+        if not config.CACHE_DIR or PACKAGE not in pathlib.Path(py_file).resolve().parents:
+            return None
+        return super().from_function(py_func, py_file)
 
 
 def source_key(package: pathlib.Path = PACKAGE) -> str:
@@ -140,4 +171,6 @@ def apply() -> bool:
     if folder is None:
         return False
     config.CACHE_DIR = folder  # type: ignore[attr-defined]  # (numba sets its settings at import)
+    if PackageLocator not in _LOCATORS:
+        _LOCATORS.insert(0, PackageLocator)
     return True

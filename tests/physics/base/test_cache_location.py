@@ -111,6 +111,31 @@ def test_an_edited_callee_in_another_file_is_compiled_again_not_loaded_stale(tmp
     assert second.returncode == 0 and float(second.stdout) == 0.0, second.stderr[-2000:]  # the new code
 
 
+HITS = """
+from ballenv.physics.base import jit
+print(len(jit.python_entry(polygon_area).stats.cache_hits))
+"""
+
+
+def test_two_checkouts_of_the_same_sources_share_their_kernels(tmp_path):
+    # the second checkout, elsewhere on the disk, loads what the first compiled
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+    runs = []
+    for name in ("first", "second"):
+        package = tmp_path / name / "ballenv"
+        shutil.copytree(cache_location.PACKAGE, package, ignore=shutil.ignore_patterns("__pycache__"))
+        run = [sys.executable, "-c", AREA + HITS]
+        env["PYTHONPATH"] = str(package.parent)
+        runs.append(subprocess.run(run, env=env, capture_output=True, text=True, timeout=300, cwd=tmp_path))
+    first, second = runs
+    assert first.returncode == 0 and first.stdout.split() == ["1.0", "0"], first.stderr[-2000:]
+    assert "compiling the simulator" in first.stderr
+    assert second.returncode == 0 and second.stdout.split() == ["1.0", "1"], second.stderr[-2000:]
+    assert "compiling" not in second.stderr
+    folder = tmp_path / "cache" / cache_location.source_key()
+    assert (folder / "physics" / "base").is_dir()  # the module's folder within the package
+
+
 def test_a_populated_read_only_cache_is_copied_to_the_writable_folder(homes, caplog):
     shipped = homes / "install" / "0123456789abcdef"
     (shipped / "physics").mkdir(parents=True)
