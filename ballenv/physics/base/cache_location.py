@@ -35,10 +35,9 @@ from collections.abc import Callable
 import numba
 from numba.core import caching, config
 
-from .compile_lock import private_dir
+from .compile_lock import PACKAGE, private_dir, within_package
 from .compile_notice import log_info
 
-PACKAGE = pathlib.Path(__file__).resolve().parents[2]  # ballenv/
 KERNEL_PACKAGES = ("physics", "envs", "shell")  # where kernels and the constants they freeze are defined
 KEEP = 4  # cache folders of other sources kept under one parent
 IDLE = 86400.0  # s: a folder beyond those is removed once unused for this long
@@ -65,14 +64,13 @@ class PackageLocator(_UserLocator):
 
     def __init__(self, py_func, py_file):
         super().__init__(py_func, py_file)
-        folder = pathlib.Path(py_file).resolve().parent.relative_to(PACKAGE)
-        self._cache_path = os.path.join(config.CACHE_DIR, *folder.parts)
+        self._cache_path = os.path.join(config.CACHE_DIR, *within_package(py_file).parent.parts)
 
     @classmethod
     def from_function(cls, py_func, py_file):
         """The locator of ``py_func`` if ``py_file`` lies in this package and a cache folder is
         set, else None (numba's own locators then place it)."""
-        if not config.CACHE_DIR or PACKAGE not in pathlib.Path(py_file).resolve().parents:
+        if not config.CACHE_DIR or within_package(py_file) is None:
             return None
         return super().from_function(py_func, py_file)
 

@@ -6,8 +6,9 @@ numba's on-disk cache.
 numba compiles a signature a process has not got in memory unless its disk cache holds it, and it
 writes the cache only when that compilation ends; processes that start together all miss the cache
 and each compiles the same code (tens of seconds of CPU each, for the simulator's step). Here each
-Python-called kernel (:func:`.jit.python_entry`) takes a lock file named after its source file, name
-and argument types (``filelock``: fcntl/msvcrt, released if the process dies) around numba's
+Python-called kernel (:func:`.jit.python_entry`) takes a lock file named after its source file (its
+path within the package, as the cache files it: two checkouts of the same sources share the lock),
+name and argument types (``filelock``: fcntl/msvcrt, released if the process dies) around numba's
 compilation, which looks in the disk cache again first, so a process that waited loads what the
 first one wrote. A process that waits longer than ``QUIET_WAIT`` says so (:func:`.compile_notice.log_info`),
 once: the first such wait of the process logs one line, later ones nothing (on a warm cache the
@@ -25,6 +26,7 @@ kernel compiles without a lock, as numba does.
 
 import hashlib
 import os
+import pathlib
 import stat
 
 from filelock import FileLock, Timeout
@@ -33,10 +35,17 @@ from numba.core.registry import CPUDispatcher
 
 from .compile_notice import log_info
 
+PACKAGE = pathlib.Path(__file__).resolve().parents[2]  # ballenv/
 WAIT_LIMIT = 900.0  # s: the longest wait for another process's compilation (a cold step: minutes)
 QUIET_WAIT = 3.0  # s: a wait this short is not reported (another process loading from the cache)
 WAITING = "waiting for another process compiling the simulator (%s); it then loads from the cache"
 GAVE_UP = "waited %.0f s for another process compiling the simulator (%s); compiling it here instead"
+
+
+def within_package(path):
+    """Source file ``path`` relative to the package's folder, or None if it lies outside it."""
+    path = pathlib.Path(path).resolve()
+    return path.relative_to(PACKAGE) if PACKAGE in path.parents else None
 
 
 def lock_dir():
@@ -67,7 +76,8 @@ def lock_path(dispatcher, signature):
     """The lock file of ``dispatcher``'s compilation for ``signature`` (numba types) into numba's
     cache directory (``NUMBA_CACHE_DIR``, or beside the source)."""
     function = dispatcher.py_func
-    key = repr((config.CACHE_DIR, function.__code__.co_filename, function.__qualname__, signature))
+    source = within_package(function.__code__.co_filename) or function.__code__.co_filename
+    key = repr((config.CACHE_DIR, str(source), function.__qualname__, signature))
     return os.path.join(lock_dir(), hashlib.sha256(key.encode()).hexdigest()[:32] + ".lock")
 
 

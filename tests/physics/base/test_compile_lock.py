@@ -3,6 +3,8 @@
 import json
 import logging
 import os
+import pathlib
+import shutil
 import stat
 import subprocess
 import sys
@@ -161,3 +163,31 @@ def _halved(x):
 
 def _negated(x):
     return -x
+
+
+LOCK_OF_AREA = """
+from numba import types
+from ballenv.physics.base import compile_lock, jit
+from ballenv.physics.base.geometry import polygon_area
+print(compile_lock.lock_path(jit.python_entry(polygon_area), (types.float64[:, ::1],)))
+"""
+
+
+def test_two_checkouts_of_the_same_sources_share_a_kernels_lock(tmp_path):
+    # as they share its cache files (cache_location.PackageLocator): one compiles, the other waits
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), BALLENV_LOCK_DIR=str(tmp_path / "locks"))
+    paths = []
+    for name in ("first", "second"):
+        package = tmp_path / name / "ballenv"
+        shutil.copytree(compile_lock.PACKAGE, package, ignore=shutil.ignore_patterns("__pycache__"))
+        env["PYTHONPATH"] = str(package.parent)
+        run = subprocess.run([sys.executable, "-c", LOCK_OF_AREA], env=env, capture_output=True, text=True)
+        assert run.returncode == 0, run.stderr[-2000:]
+        paths.append(run.stdout.strip())
+    assert paths[0] == paths[1] and paths[0].startswith(str(tmp_path / "locks"))
+    assert compile_lock.within_package(
+        compile_lock.PACKAGE / "physics" / "step" / "newton.py"
+    ) == pathlib.Path("physics/step/newton.py")
+    assert (
+        compile_lock.within_package(tmp_path / "first" / "ballenv" / "physics" / "step" / "newton.py") is None
+    )
