@@ -1,4 +1,10 @@
-"""Shared helpers for the physics tests: deformed rings, dense Jacobians, finite differences."""
+"""Shared helpers for the physics tests: deformed rings, dense Jacobians, finite differences, runs in
+two checkouts of the package."""
+
+import os
+import shutil
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -53,6 +59,22 @@ def finite_difference_gradient(energy, x, step):
         xm[k] -= step
         out[k] = (energy(xp.reshape(x.shape)) - energy(xm.reshape(x.shape))) / (2 * step)
     return out.reshape(x.shape)
+
+
+def run_in_two_checkouts(tmp_path, script, package, **env):
+    """``python -c script`` in two copies of ``package`` (the ``ballenv`` folder) in different folders
+    under ``tmp_path``, one after the other, with ``env`` added to this process's environment; the
+    two finished processes."""
+    runs = []
+    for name in ("first", "second"):
+        copy = tmp_path / name / "ballenv"
+        shutil.copytree(package, copy, ignore=shutil.ignore_patterns("__pycache__"))
+        run_env = dict(os.environ, PYTHONPATH=str(copy.parent), **env)
+        run = [sys.executable, "-c", script]
+        runs.append(
+            subprocess.run(run, env=run_env, capture_output=True, text=True, timeout=300, cwd=tmp_path)
+        )
+    return runs
 
 
 def relative_error(a, b):

@@ -12,6 +12,8 @@ import pytest
 
 from ballenv.physics.base import cache_location
 
+from ..conftest import run_in_two_checkouts
+
 
 @pytest.fixture
 def homes(monkeypatch, tmp_path, caplog):
@@ -119,14 +121,8 @@ print(len(jit.python_entry(polygon_area).stats.cache_hits))
 
 def test_two_checkouts_of_the_same_sources_share_their_kernels(tmp_path):
     # the second checkout, elsewhere on the disk, loads what the first compiled
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
-    runs = []
-    for name in ("first", "second"):
-        package = tmp_path / name / "ballenv"
-        shutil.copytree(cache_location.PACKAGE, package, ignore=shutil.ignore_patterns("__pycache__"))
-        run = [sys.executable, "-c", AREA + HITS]
-        env["PYTHONPATH"] = str(package.parent)
-        runs.append(subprocess.run(run, env=env, capture_output=True, text=True, timeout=300, cwd=tmp_path))
+    cache = str(tmp_path / "cache")
+    runs = run_in_two_checkouts(tmp_path, AREA + HITS, cache_location.PACKAGE, NUMBA_CACHE_DIR=cache)
     first, second = runs
     assert first.returncode == 0 and first.stdout.split() == ["1.0", "0"], first.stderr[-2000:]
     assert "compiling the simulator" in first.stderr

@@ -4,7 +4,6 @@ import json
 import logging
 import os
 import pathlib
-import shutil
 import stat
 import subprocess
 import sys
@@ -15,6 +14,8 @@ from numba.core import types
 from ballenv.physics.base import compile_lock, jit
 from ballenv.physics.base.compile_lock import SharedCompile, private_dir
 from ballenv.physics.walls.self_barrier import point_edge_distance2
+
+from ..conftest import run_in_two_checkouts
 
 CALL_ON_GO = """
 import json, os, sys, time
@@ -175,18 +176,13 @@ print(compile_lock.lock_path(jit.python_entry(polygon_area), (types.float64[:, :
 
 def test_two_checkouts_of_the_same_sources_share_a_kernels_lock(tmp_path):
     # as they share its cache files (cache_location.PackageLocator): one compiles, the other waits
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), BALLENV_LOCK_DIR=str(tmp_path / "locks"))
-    paths = []
-    for name in ("first", "second"):
-        package = tmp_path / name / "ballenv"
-        shutil.copytree(compile_lock.PACKAGE, package, ignore=shutil.ignore_patterns("__pycache__"))
-        env["PYTHONPATH"] = str(package.parent)
-        run = subprocess.run(
-            [sys.executable, "-c", LOCK_OF_AREA], env=env, capture_output=True, text=True, timeout=300
-        )
-        assert run.returncode == 0, run.stderr[-2000:]
-        paths.append(run.stdout.strip())
-    assert paths[0] == paths[1] and paths[0].startswith(str(tmp_path / "locks"))
+    locks, cache = tmp_path / "locks", str(tmp_path / "cache")
+    runs = run_in_two_checkouts(
+        tmp_path, LOCK_OF_AREA, compile_lock.PACKAGE, NUMBA_CACHE_DIR=cache, BALLENV_LOCK_DIR=str(locks)
+    )
+    assert all(run.returncode == 0 for run in runs), runs[-1].stderr[-2000:]
+    paths = [run.stdout.strip() for run in runs]
+    assert paths[0] == paths[1] and paths[0].startswith(str(locks))
     newton = pathlib.Path("physics", "step", "newton.py")
     assert compile_lock.within_package(compile_lock.PACKAGE / newton) == newton
     assert compile_lock.within_package(tmp_path / "first" / "ballenv" / newton) is None
