@@ -1,14 +1,17 @@
 """What passing a record of arrays costs numba's compiler: a NamedTuple (numba's default, passed by
 value: every array's data pointer, shape and strides become arguments of every call) against a
-StructRef (``numba.experimental.structref``: one pointer), through the same chain of compiled
-functions.
+StructRef (``numba.experimental.structref``: one pointer, in numba's reference-counted runtime) and
+the package's ``RecordRef`` (``ballenv/physics/base/record_ref.py``: one pointer, no runtime),
+through the same chain of compiled functions.
 
 The chain has ``DEPTH`` functions, none inlined; each reads two arrays of the record, writes one and
 calls the next twice, as the simulator's kernels pass their records (``ShellStep``, ``Work``, the
-ring's ``Model``) down their calls. Each row is a new process with an empty numba cache
-(``NUMBA_CACHE_DIR``): its compile time is the first call's wall time (s), its call time the mean
-of later calls (us; the chain makes ``2^DEPTH - 1`` calls). A StructRef's kernels load from numba's
-cache like any other (the page checks it: a second process, the same cache, no compile).
+ring's ``Model``) down their calls. As the package's kernels, every function but the first is
+compiled without Python wrappers and, but for the StructRef's, without reference counting. Each
+row is a new process with an empty numba cache (``NUMBA_CACHE_DIR``): its compile time is the
+first call's wall time (s), its call time the mean of later calls (us; the chain makes
+``2^DEPTH - 1`` calls). Both references' kernels load from numba's cache like any other (the page
+checks it: a second process, the same cache, no compile).
 
     python benchmarks/record_passing.py      # writes benchmarks/results/record_passing.md
 """
@@ -26,6 +29,7 @@ from ballenv.files import write_text
 RESULTS = pathlib.Path(__file__).parent / "results"
 DEPTH = 12  # functions in the chain
 SIZES = (10, 30, 60, 120)  # arrays in the record
+KINDS = ("NamedTuple", "StructRef", "RecordRef")
 CALLS = 2000
 CHAIN = """
 import json, pathlib, sys, time
@@ -35,7 +39,7 @@ kind, n, depth, calls = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), int(sys
 names = [f"a{i}" for i in range(n)]
 lines = ["from collections import namedtuple", "from numba import njit, types",
          "from numba.experimental import structref", f"NAMES = {names!r}"]
-if kind == "NamedTuple":
+if kind != "StructRef":
     lines += ["Record = namedtuple('Record', NAMES)"]
 else:
     lines += ["@structref.register", "class RecordType(types.StructRef):",
@@ -44,7 +48,9 @@ else:
               "class Record(structref.StructRefProxy):", "    pass",
               "structref.define_proxy(Record, RecordType, NAMES)"]
 for d in range(depth - 1, -1, -1):
-    lines += ["@njit(cache=True)", f"def f{d}(r, x):", f"    s = r.a{d % n}[0] + r.a{(7 * d + 3) % n}[1]",
+    wrappers = "" if d == 0 else ", no_cpython_wrapper=True, no_cfunc_wrapper=True"
+    lines += [f"@njit(cache=True, _nrt={kind == 'StructRef'}{wrappers})", f"def f{d}(r, x):",
+              f"    s = r.a{d % n}[0] + r.a{(7 * d + 3) % n}[1]",
               f"    r.a{(5 * d + 1) % n}[2] += s"]
     if d < depth - 1:
         lines += [f"    s += f{d + 1}(r, x)", f"    s += f{d + 1}(r, 0.5 * x)"]
@@ -56,6 +62,9 @@ sys.path.insert(0, ".")
 import chain
 
 record = chain.Record(*[np.zeros(3) for _ in names])
+if kind == "RecordRef":
+    from ballenv.physics.base.record_ref import RecordRef
+    record = RecordRef(record)
 start = time.perf_counter()
 chain.f0(record, 1.0)
 first = time.perf_counter() - start
@@ -81,7 +90,7 @@ def rows() -> list[dict]:
     out = []
     for n in SIZES:
         row: dict = {"n": n}
-        for kind in ("NamedTuple", "StructRef"):
+        for kind in KINDS:
             with tempfile.TemporaryDirectory() as work:
                 row[kind] = measure(kind, n, work)
                 row[kind + " cached"] = measure(kind, n, work)
@@ -92,16 +101,18 @@ def rows() -> list[dict]:
 def page(results: list[dict]) -> str:
     name = pathlib.Path(__file__).relative_to(pathlib.Path(__file__).parents[1])
     head = (
-        "| arrays in the record | NamedTuple: compile (s) | StructRef: compile (s) | ratio "
-        "| NamedTuple: call (us) | StructRef: call (us) | second process: compiled (s), cache hits "
-        "|\n|---:|---:|---:|---:|---:|---:|---|\n"
+        "| arrays in the record | compile (s): NamedTuple | StructRef | RecordRef "
+        "| NamedTuple over RecordRef | call (us): NamedTuple | StructRef | RecordRef "
+        "| second process: compiled (s), cache hits |\n|---:|---:|---:|---:|---:|---:|---:|---:|---|\n"
     )
     body = "".join(
-        f"| {r['n']} | {r['NamedTuple']['first']:.2f} | {r['StructRef']['first']:.2f} "
-        f"| {r['NamedTuple']['first'] / r['StructRef']['first']:.1f} "
-        f"| {1e6 * r['NamedTuple']['call']:.1f} | {1e6 * r['StructRef']['call']:.1f} "
-        f"| {r['NamedTuple cached']['first']:.2f}, {r['NamedTuple cached']['hits']}; "
-        f"{r['StructRef cached']['first']:.2f}, {r['StructRef cached']['hits']} |\n"
+        f"| {r['n']} | "
+        + " | ".join(f"{r[k]['first']:.2f}" for k in KINDS)
+        + f" | {r['NamedTuple']['first'] / r['RecordRef']['first']:.1f} | "
+        + " | ".join(f"{1e6 * r[k]['call']:.1f}" for k in KINDS)
+        + " | "
+        + "; ".join(f"{r[k + ' cached']['first']:.2f}, {r[k + ' cached']['hits']}" for k in KINDS)
+        + " |\n"
         for r in results
     )
     return (
@@ -112,7 +123,7 @@ def page(results: list[dict]) -> str:
         "Compile: the first call's wall time, numba's import excluded. Call: the whole chain "
         f"({2**DEPTH - 1} calls) from Python, mean of {CALLS}. Second process: the first call's "
         "wall time and the entry point's cache hits in a new process on the same cache (NamedTuple; "
-        "StructRef): both load their machine code.\n"
+        "StructRef; RecordRef): all load their machine code.\n"
     )
 
 

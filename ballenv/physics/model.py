@@ -11,8 +11,9 @@ from a :class:`~ballenv.physics.scene.Scene`; :func:`rings_view` slices a record
 from typing import NamedTuple
 
 import numpy as np
-from numba import types
 from numba.extending import overload
+
+from .base.record_ref import is_record
 
 CONTACT_NONE = 0
 CONTACT_MASS_MODIFICATION = 1
@@ -230,7 +231,7 @@ def _per_ring_fields(cls):
 
 @overload(rings_view)
 def _rings_view(record, start, stop):
-    if not isinstance(record, types.BaseNamedTuple) or record.instance_class not in (Model, State, Drive):
+    if not is_record(record) or record.instance_class not in (Model, State, Drive):
         return None
     cls = record.instance_class
     sliced = _per_ring_fields(cls)

@@ -52,6 +52,7 @@ from .base.layout import (
     STATUS_IMPULSE_AT_DT_MIN,
     STATUS_STEP_TOO_SMALL,
 )
+from .base.record_ref import reference
 from .build import (
     build,
     build_drive,
@@ -147,13 +148,13 @@ class Simulation:
         _check_above_grounds(caller, self.model.grounds, self.state.x)
         if self.model.collide:
             _check_apart(caller, self.model, self.state.x, self.ws)
-        initial_state_values(self.model, self.solver, self.state, self.ws)
+        initial_state_values(reference(self.model), self.solver, reference(self.state), reference(self.ws))
         self.clock = np.zeros(N_CLOCK)
         self.clock[CLOCK_H] = self.solver.dt
         self.counters = np.zeros(N_COUNTERS, dtype=np.int64)
         capacity = 1 + (int(np.ceil(expected_end / output_dt)) + 1 if output_dt and expected_end else RECORDS)
         self.rec = empty_recording(capacity, n_rings, n_nodes, EVENT_ROWS_PER_RING * n_rings)
-        record(self.model, 0, 0.0, self.state, self.rec)
+        record(reference(self.model), 0, 0.0, reference(self.state), self.rec)
         self.counters[COUNT_RECORDS] = 1
         self.failure: str | None = None
         self.rescues = 0  # steps Newton's rescue took (_rescued)
@@ -196,9 +197,11 @@ class Simulation:
     def _advance_to(self, target: float, t_end: float) -> int:
         """Compiled steps until ``target`` (s), landing on ``t_end``; grows the recording when full."""
         while True:
+            drive = None if self.drive is None else reference(self.drive)
             status = advance(
-                self.model, self.solver, self.ws, self.state, self.trial, self.clock, self.counters,
-                target, t_end, 0.0 if self.output_dt is None else self.output_dt, self.rec, self.drive,
+                reference(self.model), self.solver, reference(self.ws), reference(self.state),
+                reference(self.trial), self.clock, self.counters, target, t_end,
+                0.0 if self.output_dt is None else self.output_dt, self.rec, drive,
             )  # fmt: skip
             if status != STATUS_BUFFER_FULL:
                 return status
@@ -303,13 +306,15 @@ class Simulation:
         pressure = check_gauge_pressure(owner, "pressure", pressure, spec, self.scene.atmospheric_pressure)
         duration = check_real(owner, "duration", duration, 0.0, 1e6, "s")
         if duration > 0.0:
-            ramp_rest_pressure(self.model, self._driven(), ring, pressure, self.t, self.t + duration, self.ws)
+            model, drive, ws = (reference(r) for r in (self.model, self._driven(), self.ws))
+            ramp_rest_pressure(model, drive, ring, pressure, self.t, self.t + duration, ws)
             return
         s = self.state
-        set_rest_pressure(self.model, ring, pressure, s.x[ring], s.v[ring], s.energy[ring], self.ws)
+        model, ws = reference(self.model), reference(self.ws)
+        set_rest_pressure(model, ring, pressure, s.x[ring], s.v[ring], s.energy[ring], ws)
         self._rest_pressures[ring] = pressure
         if self.drive is not None:
-            hold_gas(self.model, self.drive, ring, pressure, self.scene.rings[0].n_nodes)
+            hold_gas(model, reference(self.drive), ring, pressure, self.scene.rings[0].n_nodes)
 
     def apply_impulse(
         self, ring: int, nodes: ArrayLike, impulse: tuple[float, float], duration: float = 0.0
@@ -336,11 +341,21 @@ class Simulation:
         duration = check_real(owner, "duration", duration, 0.0, 1e6, "s")
         nodes = chosen.astype(np.int64)
         if duration > 0.0:
-            spread_impulse(self._driven(), ring, nodes, len(nodes), jx, jy, self.t, self.t + duration)
+            drive = reference(self._driven())
+            spread_impulse(drive, ring, nodes, len(nodes), jx, jy, self.t, self.t + duration)
             return
         s = self.state
         apply_impulse(
-            self.model, ring, s.x[ring], s.v[ring], s.energy[ring], self.ws, nodes, len(nodes), jx, jy
+            reference(self.model),
+            ring,
+            s.x[ring],
+            s.v[ring],
+            s.energy[ring],
+            reference(self.ws),
+            nodes,
+            len(nodes),
+            jx,
+            jy,
         )
 
     def _driven(self) -> Drive:
@@ -350,7 +365,7 @@ class Simulation:
             n_nodes = self.scene.rings[0].n_nodes
             self.drive = build_drive(len(self.scene.rings), n_nodes)
             for ring, pressure in enumerate(self._rest_pressures):
-                hold_gas(self.model, self.drive, ring, float(pressure), n_nodes)
+                hold_gas(reference(self.model), reference(self.drive), ring, float(pressure), n_nodes)
         return self.drive
 
     def stats(self) -> SimulationStats:

@@ -19,6 +19,7 @@ from numba.extending import overload
 
 from ..base.jit import kernel
 from ..base.linalg import MAX_LOW_RANK
+from ..base.record_ref import is_record
 from . import EFFECTS
 
 NO_PARAMETERS = np.zeros(0)  # ``p`` of an effect without parameters of its own (a compiled constant)
@@ -76,7 +77,7 @@ ENERGY_KINETIC = 0
 # ------------------------------------------------------------------ compile-time unrolled sums
 def _effects_of(model):
     """The effect modules of a Model's numba type (the record dtype of ``effect_parameters``)."""
-    if not isinstance(model, types.BaseNamedTuple) or "effect_parameters" not in model.fields:
+    if not is_record(model) or "effect_parameters" not in model.fields:
         return None
     typ = model.types[model.fields.index("effect_parameters")]
     if not (isinstance(typ, types.Array) and isinstance(typ.dtype, types.Record)):
