@@ -3,9 +3,12 @@
 import pickle
 from typing import NamedTuple
 
+import numba
 import numpy as np
 import pytest
+from llvmlite import ir
 from numba import njit
+from numba.core.registry import cpu_target
 
 from ballenv.physics import Ground, Ring, Scene, Simulation
 from ballenv.physics.base import record_ref
@@ -73,6 +76,9 @@ def test_a_record_ref_passes_one_pointer_where_a_named_tuple_passes_every_array(
     by_type = {str(sig[0]).split("(")[0]: sig for sig in _read.signatures}
     assert set(by_type) == {f"RecordRef.{__name__}.Outer", "Outer"}
     ref_type = RecordRef(record).numba_type
+    models = cpu_target.target_context.data_model_manager
+    assert models[ref_type].get_value_type() == ir.IntType(8).as_pointer()  # one pointer
+    assert len(models[numba.typeof(record)].get_value_type().elements) == len(Outer._fields)
     assert is_record(ref_type) and ref_type.instance_class is Outer
     assert ref_type.fields == Outer._fields
     assert ref_type.offsets["column"] == (5 + 2 * 2) * record_ref.WORD  # after x's descriptor
@@ -97,7 +103,7 @@ def test_reference_makes_one_record_ref_per_record_and_keeps_a_bounded_number():
     for other in others:
         reference(other)
     assert len(record_ref._held) == record_ref.HELD
-    assert id(record) not in record_ref._held or record_ref._held[id(record)].record is record
+    assert id(record) not in record_ref._held  # the oldest, let go
 
 
 def test_a_field_of_no_known_layout_is_refused_by_name():
