@@ -23,12 +23,15 @@ That equation is the stationarity of (J)::
 solution (increment.py). Newton's method starts from the predictor ``x0 + h v0 + h^2 a0 / 2`` (cut
 short of the grounds), solves with stepsolve.py, cuts each correction so that no vertex reaches a
 ground (ground.max_step) and halves it until ``Phi`` drops (Armijo) or, below ``Phi``'s rounding,
-``|grad Phi|`` does. It stops when every vertex's residual ``|grad Phi|_i / m_i`` is below
-``tol (|g| + R / h^2)`` (m/s^2); otherwise :class:`StepFailure` (the step is rejected). The skin's
-element matrices ``K`` are those of the step's first iterate, evaluated again only when an
-iteration lowered the residual by less than ``1 / LAG_CONTRACTION`` (the stopping test, not the
-matrix, sets the solution); CG's tolerance follows the force the test asks for (:func:`forcing`).
-The step is one compiled call (:func:`step_kernel`) on the preallocated records of stepdata.py.
+``|grad Phi|`` does; before each correction after the first, the vertices touching a ground
+descend each on its own part of ``Phi`` (relax.py: the barrier and friction's stiff kinks, which
+would otherwise cut the whole correction's step), kept if ``Phi`` dropped. It stops when every
+vertex's residual ``|grad Phi|_i / m_i`` is below ``tol (|g| + R / h^2)`` (m/s^2); otherwise
+:class:`StepFailure` (the step is rejected). The skin's element matrices ``K`` are those of the
+step's first iterate, evaluated again only when an iteration lowered the residual by less than
+``1 / LAG_CONTRACTION`` (the stopping test, not the matrix, sets the solution); CG's tolerance
+follows the force the test asks for (:func:`forcing`). The step is one compiled call
+(:func:`step_kernel`) on the preallocated records of stepdata.py.
 """
 
 import math
@@ -42,7 +45,7 @@ from ...physics.step import integrator
 from ..rest.equilibrium import ARMIJO, HALVINGS
 from ..skin import damping, potential
 from ..touch import drum, drums, ground
-from . import increment
+from . import increment, relax
 from .stepdata import ShellStep, Start, make_start
 
 F64 = NDArray[np.float64]
@@ -149,6 +152,22 @@ def forcing(grad, force_goal):
 
 
 @kernel
+def relaxed(method, st, sp, wk, goal, e, residual):
+    """The contact vertices' own descent (relax.py) from ``wk.x``, where ``Phi`` is ``e`` (J) and
+    the residual ``residual`` (m/s^2): kept if ``Phi`` dropped, with the gradient there. Returns
+    ``(Phi, residual)`` at ``wk.x``."""
+    copy_into(wk.trial, wk.x)
+    if relax.relax(st, sp, wk, goal) == 0:
+        return e, residual
+    moved = increment.incremental(method, st, sp, wk.x, wk)
+    if not moved < e:
+        copy_into(wk.x, wk.trial)
+        return e, residual
+    increment.incremental_gradient(method, st, sp, wk.x, wk, wk.grad, wk.blocks)
+    return moved, residual_acceleration(wk.grad, st.problem.model.mass)
+
+
+@kernel
 def newton(method, st, sp, wk, matrices):
     """Newton's iteration from ``wk.x``: ``(status, iterations, CG iterations, envelope solves)``
     (status 0: converged, else a key of ``FAILURES``). The skin's element matrices are evaluated
@@ -166,6 +185,8 @@ def newton(method, st, sp, wk, matrices):
     for iteration in range(method.solver.newton_max_iter + 1):
         increment.incremental_gradient(method, st, sp, wk.x, wk, wk.grad, wk.blocks)
         residual = residual_acceleration(wk.grad, mass)
+        if iteration > 0 and residual > goal:
+            e, residual = relaxed(method, st, sp, wk, goal, e, residual)
         if math.isnan(residual):
             return 1, iteration, cg_total, envelope_solves
         if residual <= goal:

@@ -52,6 +52,9 @@ class Work(NamedTuple):
     bending_age: NDArray[np.int64]  # (1,): fresh assemblies since the hinges' matrices, -1: none
     u3: F64  # (3,)
     energy: F64  # (1,) J: the total energy at the step's end (implicit.total_energy)
+    vertex_grad: F64  # (1, 3) N: a contact vertex's barriers' and friction's gradient (relax.py)
+    vertex_hess: F64  # (1, 3, 3) N/m: their Hessian
+    vertex_block: F64  # (3, 3) N/m: the rest of its block of Newton's matrix
 
 
 class ShellStep(NamedTuple):
@@ -90,6 +93,7 @@ def make_work(n_vertices: int, n_grounds: int) -> Work:
         z(v3), z(v3), z(v3), z(v3), z(v3), z(v3),
         z(v3), z(b3), z(v3), z(b3), z(v3), z(v3), z(v3), z(v3), z((n_vertices, n_grounds)),
         z((4,) + v3), z(n_vertices), np.full(1, -1, dtype=np.int64), z(3), z(1),
+        z((1, 3)), z((1, 3, 3)), z((3, 3)),
     )  # fmt: skip
 
 

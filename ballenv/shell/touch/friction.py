@@ -23,7 +23,7 @@ from ...physics.base.jit import kernel
 
 
 @kernel(inline="always")
-def _slip(x, x0, normals, slide, i, g, u):
+def slip(x, x0, normals, slide, i, g, u):
     """``u = T (x_i - x0_i) - s_g`` into ``u`` (3,); returns ``|u|`` (m)."""
     dn = 0.0
     for a in range(3):
@@ -72,7 +72,7 @@ def friction_energy(x, x0, normals, slide, lam, mu, e, u):
             continue
         for i in range(x.shape[0]):
             if lam[i, g] > 0.0:
-                y = _slip(x, x0, normals, slide, i, g, u)
+                y = slip(x, x0, normals, slide, i, g, u)
                 total += mu[g] * lam[i, g] * smoothed(y, e)
     return total
 
@@ -86,7 +86,7 @@ def add_friction(x, x0, normals, slide, lam, mu, e, grad, blocks, u):
         for i in range(x.shape[0]):
             if lam[i, g] <= 0.0:
                 continue
-            y = _slip(x, x0, normals, slide, i, g, u)
+            y = slip(x, x0, normals, slide, i, g, u)
             add_vertex(grad, blocks, i, mu[g] * lam[i, g], y, e, u, normals[g])
 
 
@@ -101,7 +101,7 @@ def friction_work(x, x0, normals, slide, lam, mu, e, u):
         for i in range(x.shape[0]):
             if lam[i, g] <= 0.0:
                 continue
-            y = _slip(x, x0, normals, slide, i, g, u)
+            y = slip(x, x0, normals, slide, i, g, u)
             f1_y = slope_over_slip(y, e)
             for a in range(3):
                 total -= mu[g] * lam[i, g] * f1_y * u[a] * slide[g, a]

@@ -26,8 +26,16 @@ CCD_SAFETY = 0.8  # a straight motion stops at this fraction of the way to a gro
 
 
 @kernel(inline="always")
-def _distance(x, i, normals, heights, g):
+def distance(x, i, normals, heights, g):
+    """``d = n_g . x_i - h_g`` (m) of vertex ``i`` from ground ``g``."""
     return normals[g, 0] * x[i, 0] + normals[g, 1] * x[i, 1] + normals[g, 2] * x[i, 2] - heights[g]
+
+
+@kernel(inline="always")
+def barrier_derivatives(d, dhat, kappa):
+    """``(dB/dd (N), d^2B/dd^2 (N/m))`` of a vertex at distance ``0 < d < dhat`` (m) (module doc)."""
+    y = d * d / (dhat * dhat)
+    return 2.0 * kappa * d * beta_slope(y), kappa * (4.0 * y * beta_curvature(y) + 2.0 * beta_slope(y))
 
 
 @kernel
@@ -36,7 +44,7 @@ def barrier_energy(x, normals, heights, dhat, kappa):
     total = 0.0
     for g in range(normals.shape[0]):
         for i in range(x.shape[0]):
-            d = _distance(x, i, normals, heights, g)
+            d = distance(x, i, normals, heights, g)
             if d < dhat:
                 total += kappa * dhat * dhat * beta(d * d / (dhat * dhat)) if d > 0.0 else math.inf
     return total
@@ -49,11 +57,9 @@ def add_barrier(x, normals, heights, dhat, kappa, grad, blocks):
     touching = 0
     for g in range(normals.shape[0]):
         for i in range(x.shape[0]):
-            d = _distance(x, i, normals, heights, g)
+            d = distance(x, i, normals, heights, g)
             if 0.0 < d < dhat:
-                y = d * d / (dhat * dhat)
-                slope = 2.0 * kappa * d * beta_slope(y)
-                curvature = kappa * (4.0 * y * beta_curvature(y) + 2.0 * beta_slope(y))
+                slope, curvature = barrier_derivatives(d, dhat, kappa)
                 for a in range(3):
                     grad[i, a] += slope * normals[g, a]
                     for b in range(3):
@@ -67,7 +73,7 @@ def normal_forces(x, normals, heights, dhat, kappa, out):
     """``out[i, g]`` = the normal force ``lambda`` (N) of ground g on vertex i (0 beyond ``dhat``)."""
     for g in range(normals.shape[0]):
         for i in range(x.shape[0]):
-            d = _distance(x, i, normals, heights, g)
+            d = distance(x, i, normals, heights, g)
             out[i, g] = -2.0 * kappa * d * beta_slope(d * d / (dhat * dhat)) if 0.0 < d < dhat else 0.0
 
 
@@ -77,7 +83,7 @@ def min_distance(x, normals, heights):
     low = math.inf
     for g in range(normals.shape[0]):
         for i in range(x.shape[0]):
-            low = min(low, _distance(x, i, normals, heights, g))
+            low = min(low, distance(x, i, normals, heights, g))
     return low
 
 
@@ -90,5 +96,5 @@ def max_step(x, dx, normals, heights):
         for i in range(x.shape[0]):
             rate = normals[g, 0] * dx[i, 0] + normals[g, 1] * dx[i, 1] + normals[g, 2] * dx[i, 2]
             if rate < 0.0:
-                alpha = min(alpha, CCD_SAFETY * _distance(x, i, normals, heights, g) / -rate)
+                alpha = min(alpha, CCD_SAFETY * distance(x, i, normals, heights, g) / -rate)
     return alpha
