@@ -37,23 +37,27 @@ SWEEP_RTOLS = (1e-3, 3e-3, 1e-2, 3e-2)  # the fast preset's, and looser
 SWEEP_STEPS = 300
 
 
-def run(env, steps: int, seed: int) -> tuple[float, int]:
-    """(steps/s, accepted simulator steps) of ``steps`` random-action env steps."""
+def run(env, steps: int, seed: int) -> tuple[float, int, int]:
+    """(steps/s, accepted simulator steps, Newton iterations) of ``steps`` random-action env steps."""
     env.action_space.seed(seed)
     env.reset(seed=seed)
-    sim_steps, start = 0, time.perf_counter()
+    sim_steps, newton, start = 0, 0, time.perf_counter()
     for _ in range(steps):
         _, _, term, trunc, _ = env.step(env.action_space.sample())
         if term or trunc:
-            sim_steps += _sim_steps(env)
+            sim_steps, newton = sim_steps + _stats(env)[0], newton + _stats(env)[1]
             env.reset()
-    sim_steps += _sim_steps(env)
-    return steps / (time.perf_counter() - start), sim_steps
+    sim_steps, newton = sim_steps + _stats(env)[0], newton + _stats(env)[1]
+    return steps / (time.perf_counter() - start), sim_steps, newton
 
 
-def _sim_steps(env) -> int:
+def _stats(env) -> tuple[int, int]:
+    """(accepted simulator steps, Newton iterations) of the episode so far (0, 0 for the ring)."""
     ball = getattr(env.unwrapped, "ball", None)
-    return 0 if ball is None else ball.sim.run.stats.steps
+    if ball is None:
+        return 0, 0
+    stats = ball.sim.run.stats
+    return stats.steps, stats.newton_iterations
 
 
 def kernel_share(env, steps: int) -> float:
@@ -70,7 +74,7 @@ def kernel_share(env, steps: int) -> float:
 
     implicit.step_kernel = timed
     try:
-        rate, _ = run(env, steps, 99)
+        rate = run(env, steps, 99)[0]
     finally:
         implicit.step_kernel = kernel
     return spent[0] * rate / steps
@@ -80,15 +84,16 @@ def measure(env_id: str, mode: str, steps: int) -> dict[str, float]:
     env, ring = gym.make(env_id), gym.make(RING[mode])
     run(env, 50, 0)
     run(ring, 50, 0)
-    best, ring_best, sim_steps = 0.0, 0.0, 0
+    best, ring_best, sim_steps, newton = 0.0, 0.0, 0, 0
     for repeat in range(3):
-        rate, sim_steps = run(env, steps, repeat)
+        rate, sim_steps, newton = run(env, steps, repeat)
         best = max(best, rate)
         ring_best = max(ring_best, run(ring, 2000, repeat)[0])
     return {
         "rate": best,
         "ring": ring_best,
         "sim_steps": sim_steps / steps,
+        "newton": newton / max(sim_steps, 1),
         "kernel": kernel_share(env, steps),
     }
 
@@ -148,13 +153,13 @@ def page(rows: dict[str, dict[str, float]], steps: int, scaling: tuple[float, fl
         f"best of 3 repeats of {steps} env steps; the ring's env measured alternately in the same minutes).",
         "",
         "| env | env steps/s | target | ring's env steps/s | 3-D / ring | simulator steps per env step "
-        "| time in the implicit step |",
-        "|---|---:|---:|---:|---:|---:|---:|",
+        "| Newton iterations per simulator step | time in the implicit step |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for env_id, r in rows.items():
         lines.append(
             f"| {env_id} | {r['rate']:.0f} | {TARGET:.0f} | {r['ring']:.0f} | {r['rate'] / r['ring']:.4f} "
-            f"| {r['sim_steps']:.2f} | {100 * r['kernel']:.0f} % |"
+            f"| {r['sim_steps']:.2f} | {r['newton']:.2f} | {100 * r['kernel']:.0f} % |"
         )
     one, two = scaling
     lines += [
@@ -172,11 +177,13 @@ def page(rows: dict[str, dict[str, float]], steps: int, scaling: tuple[float, fl
         "|---:|---:|---:|---:|",
         *(f"| {r:g} | {p:.0f} | {q:.0f} | {100 * e:+.2f} % |" for r, p, q, e in sweep),
         "",
-        "The env's own Python (actions, observation, reward) is the rest of the time: the simulator's",
-        "implicit step sets the pace, at about 1-2 ms per step tried at 162 vertices. With random",
+        "The rest of the time is Python: the step control, events and records between steps, each",
+        "compiled call's unpacking of the step's records, and the env's actions, observation and",
+        "reward. The implicit step takes about 0.6-1.3 ms per step tried at 162 vertices. With random",
         "actions the pressure mode's pumping rings the ball's breathing mode, which the error control",
         "follows with steps of about a millisecond, most of them in flight; the paddle mode's strikes",
-        "ring it less.",
+        "ring it less. A step in contact with friction took 22 Newton iterations before the contact",
+        "vertices' own descent (`ballenv/shell/step/relax.py`), about 5 with it.",
         "",
     ]
     return "\n".join(lines)

@@ -10,13 +10,13 @@ The linear algebra (solve/): the envelope Cholesky (envelope.py), the block-spar
 lagged Coulomb friction (friction.py), drums' barriers (drum.py), friction (drum_friction.py),
 turning (turning.py) and what the step asks of them (drums.py), distances (distance.py), the
 barrier between shells and within one with its collision detection (contact.py, projection.py)
-and the broad phase (broadphase.py). The time step (step/): the
-implicit step, backward Euler or generalized-alpha (implicit.py), its incremental potential
-(increment.py), its contact vertices' own descent (relax.py) and records (stepdata.py); the joint step of shells that may touch (groups.py,
-joint.py, jointdata.py); the energy budget (budget.py); events (events.py). At the top: the validated
-descriptions ``Shell``, ``Ground``, ``Drum``, ``Scene`` (scene.py); ``simulate`` and ``Trajectory``
-(simulation.py); fidelity presets (presets.py); regulation balls and their drop tests (balls.py). SI
-units.
+and the broad phase (broadphase.py). The time step (step/): the implicit step, backward Euler or
+generalized-alpha (implicit.py), its incremental potential (increment.py), its contact vertices'
+own descent (relax.py) and records (stepdata.py); the joint step of shells that may touch
+(groups.py, joint.py, jointdata.py); the energy budget (budget.py); events (events.py). At the
+top: the validated descriptions ``Shell``, ``Ground``, ``Drum``, ``Scene`` (scene.py);
+``simulate`` and ``Trajectory`` (simulation.py); fidelity presets (presets.py); regulation balls
+and their drop tests (balls.py). SI units.
 """
 
 from ..physics.base.compile_notice import install as _install_compile_notice
