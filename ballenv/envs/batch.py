@@ -36,6 +36,7 @@ from ballenv.physics.base.layout import (
     STATUS_BUFFER_FULL,
     STATUS_DONE,
 )
+from ballenv.physics.base.record_ref import RecordRef
 from ballenv.physics.build import build, build_drive, build_workspace
 from ballenv.physics.effects.gas import ring_pressure
 from ballenv.physics.ground.contact import FREE
@@ -346,15 +347,18 @@ class BallBatch:
             end=np.zeros(n_envs, dtype=np.int64),
         )
         self.nodes = np.zeros(self.n_nodes, dtype=np.int64)
+        # the records the compiled calls take by reference (one pointer each; record_ref.py)
+        self._refs = tuple(RecordRef(r) for r in (self.model, self.state, self.trial, self.drive))
         self.threads = max(1, min(int(threads), n_envs))
         self._pool: ThreadPoolExecutor | None = None
         # chunk boundaries (one chunk of all envs on one thread) and the counter their numbers are drawn from
         self._chunks = np.array(guided_chunks(n_envs, self.threads) if self.threads > 1 else [0, n_envs])
         self._tickets = np.zeros(1, dtype=np.int64)
+        self._ws_ref = RecordRef(self.ws)
         if self.threads > 1:
             self._pool = ThreadPoolExecutor(self.threads - 1, thread_name_prefix="ballenv")
-            self._scratch = [(self.ws, self.nodes)] + [
-                (self._scratch_workspace(barrier), np.zeros(self.n_nodes, dtype=np.int64))
+            self._scratch = [(self._ws_ref, self.nodes)] + [
+                (RecordRef(self._scratch_workspace(barrier)), np.zeros(self.n_nodes, dtype=np.int64))
                 for _ in range(self.threads - 1)
             ]
         self.low = np.asarray(low, dtype=np.float64)
@@ -375,8 +379,9 @@ class BallBatch:
         self, e: int, centre: ArrayLike, velocity: ArrayLike, phase: float, target: float, pressure: float
     ) -> None:
         """Start env ``e`` afresh (see :func:`reset_env`)."""
+        model, state, _, drive = self._refs
         reset_env(
-            self.model, self.solver, self.ws, self.state, self.drive, self.clocks, self.counters, self.task,
+            model, self.solver, self._ws_ref, state, drive, self.clocks, self.counters, self.task,
             e, np.asarray(centre, dtype=float), np.asarray(velocity, dtype=float), float(phase),
             float(target), float(pressure), self.raw, self.low, self.high, self.obs,
         )  # fmt: skip
@@ -388,10 +393,10 @@ class BallBatch:
         actions = np.ascontiguousarray(actions, dtype=np.float64)
         self._tickets[0] = 0
         if self._pool is None:
-            self._step(self.ws, self.nodes, actions, active)
+            self._step(self._ws_ref, self.nodes, actions, active)
             return
         if self._step_batch is None:  # compile or load, once, before the threads call it
-            self._step(self.ws, self.nodes, actions, np.zeros_like(active))
+            self._step(self._ws_ref, self.nodes, actions, np.zeros_like(active))
             self._tickets[0] = 0
         calls = [self._pool.submit(self._step, ws, nodes, actions, active) for ws, nodes in self._scratch[1:]]
         try:
@@ -401,11 +406,13 @@ class BallBatch:
                 call.result()
 
     def _step(
-        self, ws: Workspace, nodes: NDArray[np.int64], actions: NDArray[np.float64], active: NDArray[np.bool_]
+        self, ws: RecordRef, nodes: NDArray[np.int64], actions: NDArray[np.float64], active: NDArray[np.bool_]
     ) -> None:
-        """One :func:`step_batch` call with scratch ``ws``, ``nodes``: the chunks it draws."""
+        """One :func:`step_batch` call with scratch ``ws`` (a Workspace's RecordRef), ``nodes``: the
+        chunks it draws."""
+        model, state, trial, drive = self._refs
         args = (
-            self.model, self.solver, ws, self.state, self.trial, self.drive, self.clocks, self.counters,
+            model, self.solver, ws, state, trial, drive, self.clocks, self.counters,
             self.records, self.records.events, self.task, actions, active, self._chunks, self._tickets,
             nodes, self.raw, self.low, self.high, self.obs,
         )  # fmt: skip

@@ -31,6 +31,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..physics.base.record_ref import RecordRef
 from ..physics.step import integrator
 from .rest.equilibrium import equilibrium
 from .scene import Scene
@@ -259,13 +260,13 @@ def error_ratio(
 
 def try_step(
     method: implicit.Integrator,
-    steps: list[stepdata.ShellStep],
+    steps: list[RecordRef],
     state: tuple[F64, F64, F64],
     h: float,
     contacts: groups.Contacts | None = None,
 ) -> list[implicit.StepResult]:
-    """Every shell's step of ``h`` (s), or :class:`implicit.StepFailure`; with ``contacts``, shells
-    that may touch step jointly (groups.py)."""
+    """Every shell's step of ``h`` (s), or :class:`implicit.StepFailure` (``steps`` the shells'
+    ShellSteps by reference); with ``contacts``, shells that may touch step jointly (groups.py)."""
     if contacts is not None:
         return contacts.step(method, state, h)
     x, v, a = state
@@ -298,6 +299,7 @@ class Run:
     ):
         self.scene = scene
         self.method, self.steps = build(scene)
+        self.refs = [RecordRef(st) for st in self.steps]  # the steps as the compiled step takes them
         touching = len(self.steps) > 1 or scene.self_contact
         dhat = scene.contact_distance
         self.contacts = groups.Contacts(self.steps, dhat, scene.self_contact) if touching else None
@@ -395,7 +397,7 @@ class Run:
             for prepare in self.preparations:
                 prepare(t, trial)
             try:
-                results = try_step(self.method, self.steps, (self.x, self.v, self.a), trial, self.contacts)
+                results = try_step(self.method, self.refs, (self.x, self.v, self.a), trial, self.contacts)
             except implicit.StepFailure:
                 h = self.reject(t, 0.5 * trial, "the step was halved")
                 continue

@@ -96,7 +96,7 @@ class Simulation:
     def rest_pressure(self, shell: int) -> float:
         """The gas amount of ``shell`` as the gauge pressure at its rest volume (Pa)."""
         model = self.run.steps[self._shell(shell)].problem.model
-        return model.absolute_pressure - model.atmospheric_pressure
+        return float(model.absolute_pressure[0]) - model.atmospheric_pressure
 
     def set_rest_pressure(self, shell: int, p0: float) -> None:
         """Sets the gas amount of ``shell`` to the rest pressure ``p0`` (Pa gauge; module doc)."""
@@ -117,13 +117,13 @@ class Simulation:
         """Sets shell ``k``'s gas amount to the rest pressure ``p0`` (Pa gauge), crediting its budget."""
         st = self.run.steps[k]
         model = st.problem.model
-        if model.absolute_pressure == p0 + model.atmospheric_pressure:
+        if model.absolute_pressure[0] == p0 + model.atmospheric_pressure:
             return
-        new_model = model._replace(absolute_pressure=p0 + model.atmospheric_pressure)
-        self.run.steps[k] = st._replace(problem=st.problem._replace(model=new_model))
         # only the gas's term changes: dE = U_new(V) - U_old(V)
         vol = volume(np.ascontiguousarray(self.x[k]), model.triangles)
-        self.run.budget[k] += float(gas_energy(new_model, vol) - gas_energy(model, vol))
+        before = gas_energy(model, vol)
+        model.absolute_pressure[0] = p0 + model.atmospheric_pressure
+        self.run.budget[k] += float(gas_energy(model, vol) - before)
 
     def ramp_rest_pressure(self, shell: int, p1: float, t1: float) -> None:
         """Ramps the gas amount of ``shell`` to the rest pressure ``p1`` (Pa gauge) at ``t1`` (s)

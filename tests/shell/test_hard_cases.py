@@ -68,7 +68,7 @@ def audit(scene, t_end, x0=None):
         np.array([total_energy(st, x, v) for x, v in zip(traj.x[:, k], traj.v[:, k], strict=True)])
         for k, st in enumerate(steps)
     )
-    gas = sum(st.problem.model.absolute_pressure * st.problem.model.rest_volume for st in steps)
+    gas = sum(st.problem.model.absolute_pressure[0] * st.problem.model.rest_volume for st in steps)
     assert energy.max() <= energy[0] + 1e-10 * gas
     for k, st in enumerate(steps):
         model = st.problem.model

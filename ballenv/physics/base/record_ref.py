@@ -124,7 +124,7 @@ def reference(record: Any) -> RecordRef:
     """The :class:`RecordRef` of ``record``, made on its first call and kept while it is among the
     last ``HELD`` records passed (a kept RecordRef holds its record, so ``id(record)`` is not
     reused while it is kept)."""
-    with _lock:  # threads stepping envs pass their records at once
+    with _lock:  # callers on several threads may pass records at once
         ref = _held.get(id(record))
         if ref is None or ref.record is not record:
             ref = _held[id(record)] = RecordRef(record)
@@ -163,9 +163,26 @@ def _load_field(context, builder, typ, value, attr):
         return context.get_dummy_value()
     model = context.data_model_manager[field_type]
     where = builder.gep(value, [ir.Constant(ir.IntType(64), typ.offsets[attr])])
-    loaded = builder.load(builder.bitcast(where, model.get_data_type().as_pointer()))
-    loaded.set_metadata("invariant.load", builder.module.add_metadata([]))
-    return model.from_data(builder, loaded)
+    data_type = model.get_data_type()
+    pointer = builder.bitcast(where, data_type.as_pointer())
+    return model.from_data(builder, _load_scalars(builder, pointer, data_type))
+
+
+def _load_scalars(builder, pointer, data_type):
+    """The value of LLVM type ``data_type`` at ``pointer``, loaded one scalar at a time, each load
+    marked invariant (an aggregate's load is split by LLVM's passes, which may drop the mark and
+    with it the loads' hoisting out of loops)."""
+    if not isinstance(data_type, ir.LiteralStructType | ir.ArrayType):
+        loaded = builder.load(pointer)
+        loaded.set_metadata("invariant.load", builder.module.add_metadata([]))
+        return loaded
+    out = ir.Constant(data_type, ir.Undefined)
+    count = len(data_type.elements) if isinstance(data_type, ir.LiteralStructType) else data_type.count
+    for k in range(count):
+        element = data_type.elements[k] if isinstance(data_type, ir.LiteralStructType) else data_type.element
+        at = builder.gep(pointer, [ir.Constant(ir.IntType(32), 0), ir.Constant(ir.IntType(32), k)])
+        out = builder.insert_value(out, _load_scalars(builder, at, element), k)
+    return out
 
 
 @unbox(RecordRefType)

@@ -144,7 +144,7 @@ def line_search(
     m, ws, loads, free = problem.model, problem.ws, problem.loads, problem.free
     e0 = potential.energy(m, ws, x, loads)
     slope = float(np.sum(grad * dx))
-    rounding = 1e-13 * (abs(m.absolute_pressure) * m.rest_volume + np.abs(loads * x).sum() + abs(e0))
+    rounding = 1e-13 * (abs(m.absolute_pressure[0]) * m.rest_volume + np.abs(loads * x).sum() + abs(e0))
     g0 = np.abs(grad[free]).max()
     trial_grad = np.zeros_like(x)
     alpha = 1.0

@@ -72,7 +72,8 @@ def add_volume_hessians(x, tri, scale, out):
 def gauge_pressure(model, vol):
     """Gauge pressure p (Pa) of the gas at volume ``vol`` (m^3)."""
     return (
-        model.absolute_pressure * (model.rest_volume / vol) ** model.gas_exponent - model.atmospheric_pressure
+        model.absolute_pressure[0] * (model.rest_volume / vol) ** model.gas_exponent
+        - model.atmospheric_pressure
     )
 
 
@@ -85,7 +86,7 @@ def gas_energy(model, vol):
         f = log_r
     else:
         f = np.expm1((1.0 - gamma) * log_r) / (1.0 - gamma)
-    return model.atmospheric_pressure * (vol - v0) - model.absolute_pressure * v0 * f
+    return model.atmospheric_pressure * (vol - v0) - model.absolute_pressure[0] * v0 * f
 
 
 @kernel

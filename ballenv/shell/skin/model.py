@@ -30,7 +30,9 @@ class ShellModel(NamedTuple):
     kb: float  # N m, bending stiffness E h^3 / (12 (1 - nu^2))
     gas_exponent: float  # gamma
     atmospheric_pressure: float  # Pa
-    absolute_pressure: float  # Pa, p0 + p_atm at the rest volume
+    absolute_pressure: NDArray[
+        np.float64
+    ]  # (1,) Pa, p0 + p_atm at the rest volume (the gas amount, set in place)
     rest_volume: float  # m^3, of the rest mesh
 
 
@@ -95,7 +97,7 @@ def build_model(
         kb=float(shell.bending_stiffness),
         gas_exponent=float(gas_exponent),
         atmospheric_pressure=float(atmospheric_pressure),
-        absolute_pressure=float(shell.pressure + atmospheric_pressure),
+        absolute_pressure=np.array([float(shell.pressure + atmospheric_pressure)]),
         rest_volume=float(gas.volume(mesh.vertices, mesh.triangles)),
     )
 

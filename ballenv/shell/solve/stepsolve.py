@@ -15,6 +15,8 @@ Sherman-Morrison solves the matrix without the rank-6 term (still symmetric posi
 Newton's direction stays one of descent).
 """
 
+from typing import NamedTuple
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -25,17 +27,22 @@ CG_MAX_ITER = 400
 RANK = 7  # the operator's low-rank terms: the gas's and the damping's six
 
 
-def block_owners(
-    triangles: NDArray[np.int64], n_vertices: int
-) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
-    """For each vertex, a triangle holding it and its corner there: ``(triangle (V,), corner (V,))``."""
+class Owners(NamedTuple):
+    """For each vertex, a triangle holding it and its corner there."""
+
+    triangle: NDArray[np.int64]  # (V,)
+    corner: NDArray[np.int64]  # (V,)
+
+
+def block_owners(triangles: NDArray[np.int64], n_vertices: int) -> Owners:
+    """Each vertex's owning triangle and corner (:class:`Owners`)."""
     tri = np.full(n_vertices, -1, dtype=np.int64)
     corner = np.zeros(n_vertices, dtype=np.int64)
     for c in range(3):
         unset = tri[triangles[:, c]] < 0
         tri[triangles[unset, c]] = np.nonzero(unset)[0]
         corner[triangles[unset, c]] = c
-    return tri, corner
+    return Owners(tri, corner)
 
 
 @kernel
@@ -62,7 +69,7 @@ def _envelope_solve(problem, owners, c_x, s, vertex_blocks, rhs, out, z, zero):
     m, ws, free = problem.model, problem.ws, problem.free
     _scale(ws.tri_hess, c_x)
     _scale(ws.hinge_hess, c_x)
-    fold_blocks(ws.tri_hess, owners[0], owners[1], vertex_blocks)
+    fold_blocks(ws.tri_hess, owners.triangle, owners.corner, vertex_blocks)
     zero[:] = 0.0
     envelope.assemble(problem.env, m.triangles, ws.tri_hess, m.hinges, ws.hinge_hess, zero, free)
     if not envelope.cholesky(problem.env):

@@ -120,7 +120,7 @@ def hold(steps: list[ShellStep], xs: list[F64], vs: list[F64], energy: float, bu
     centred = [_about_centre(st, v) for st, v in zip(steps, vs, strict=True)]
     k_d = sum(_kinetic(st, u) for st, u in zip(steps, deform, strict=True))
     k_c = sum(_kinetic(st, u) for st, u in zip(steps, centred, strict=True))
-    scale = sum(st.problem.model.absolute_pressure * st.problem.model.rest_volume for st in steps)
+    scale = sum(st.problem.model.absolute_pressure[0] * st.problem.model.rest_volume for st in steps)
     if excess <= ROUND_OFF * (scale + k_c):
         return True
     if excess > ENERGY_GROWTH_TOL * k_c:

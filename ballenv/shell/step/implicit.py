@@ -41,6 +41,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ...physics.base.jit import copy_into, kernel
+from ...physics.base.record_ref import RecordRef, reference
 from ...physics.step import integrator
 from ..rest.equilibrium import ARMIJO, HALVINGS
 from ..skin import damping, potential
@@ -98,7 +99,7 @@ def search(method, st, sp, wk, e0):
             g0 = max(g0, abs(grad[i, c]))
     slope = abs(slope)
     model = st.problem.model
-    rounding = 1e-13 * (model.absolute_pressure * model.rest_volume + abs(e0))
+    rounding = 1e-13 * (model.absolute_pressure[0] * model.rest_volume + abs(e0))
     alpha = min(ground.max_step(x, dx, st.normals, st.heights), drums.max_step(st.drums, x, dx))
     for _ in range(HALVINGS):
         for i in range(x.shape[0]):
@@ -291,16 +292,19 @@ class StepResult(NamedTuple):
     envelope_solves: int
 
 
-def step(method: Integrator, st: ShellStep, x0: F64, v0: F64, a0: F64, h: float) -> StepResult:
+def step(method: Integrator, st: ShellStep | RecordRef, x0: F64, v0: F64, a0: F64, h: float) -> StepResult:
     """One step of ``h`` (s) from ``(x0, v0, a0)`` (module doc); :class:`StepFailure` if none.
+    ``st`` is passed to the compiled step by reference: a RecordRef of it, or the record itself
+    (then :func:`record_ref.reference`'s).
 
     With friction, the normal forces are lagged as Incremental Potential Contact does: taken at
     ``x0``, then, up to ``FRICTION_LAGS`` times, at the solution, solving again while some normal
     force changed by more than ``LAG_TOL`` of the shell's weight."""
-    status, iterations, cg_iterations, envelope_solves = step_kernel(method, st, x0, v0, a0, h)
+    ref = st if isinstance(st, RecordRef) else reference(st)
+    status, iterations, cg_iterations, envelope_solves = step_kernel(method, ref, x0, v0, a0, h)
     if status != 0:
         raise StepFailure(f"the step of {h:.3e} s failed: {FAILURES[status]}")
-    wk = st.work
+    wk = ref.record.work
     return StepResult(
         wk.x.copy(), wk.v1.copy(), wk.a1.copy(), wk.force.copy(), float(wk.energy[0]),
         iterations, cg_iterations, envelope_solves,

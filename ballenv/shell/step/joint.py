@@ -104,7 +104,7 @@ def _rounding(sts, e0):
     out = 1e-13 * abs(e0)
     for k in range(len(sts)):
         model = sts[k].problem.model
-        out += 1e-13 * model.absolute_pressure * model.rest_volume
+        out += 1e-13 * model.absolute_pressure[0] * model.rest_volume
     return out
 
 

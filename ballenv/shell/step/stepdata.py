@@ -70,7 +70,7 @@ class ShellStep(NamedTuple):
     kappa: float  # N/m
     slip_speed: float  # eps_v m/s
     damping: float  # c 1/s
-    owners: tuple[NDArray[np.int64], NDArray[np.int64]]  # stepsolve.block_owners
+    owners: stepsolve.Owners  # stepsolve.block_owners
     radius: float  # m
     op: cg.Operator  # the Newton system's operator (stepsolve.py)
     start: Start
