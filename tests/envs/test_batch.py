@@ -291,3 +291,21 @@ def test_copy_env_between_batches_of_different_balls_is_refused():
     small, large = InflatedBallEnv(fidelity="fast"), InflatedBallEnv(fidelity="balanced")
     with pytest.raises(ValueError, match="32 nodes .* 64 .* must be equal"):
         large._batch.copy_env(small._batch, 0, [0])
+
+
+def test_the_compiled_step_takes_the_batchs_records_by_reference():
+    from ballenv.envs.batch import step_batch
+    from ballenv.physics.base.jit import python_entry
+    from ballenv.physics.base.record_ref import RecordRefType
+
+    env = InflatedBallEnv(action_mode="pressure")
+    env.reset(seed=0)
+    env.step(np.array([0.5], dtype=np.float32))
+    batch = env._batch
+    records = (batch.model, batch.state, batch.trial, batch.drive)
+    assert all(ref.record is r for ref, r in zip(batch._refs, records, strict=True))  # the batch's own arrays
+    signatures = [s for s in python_entry(step_batch).overloads if len(s) == 20]
+    assert signatures  # the step compiled for these arguments
+    for signature in signatures:
+        # model, workspace, state, trial state, drive: one pointer each, not their ~100 arrays
+        assert all(isinstance(signature[k], RecordRefType) for k in (0, 2, 3, 4, 5))
