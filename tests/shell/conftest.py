@@ -1,10 +1,15 @@
-"""Shared helpers for the shell tests: small models, dense Hessians and central differences."""
+"""Shared helpers for the shell tests: small models, a step pressed on a ground, dense Hessians and
+central differences."""
 
 import numpy as np
 
 from ballenv.shell.rest.modes import element_dofs
-from ballenv.shell.scene import Shell
+from ballenv.shell.scene import Ground, Scene, Shell
+from ballenv.shell.simulation import build
 from ballenv.shell.skin.model import build_model, build_workspace
+from ballenv.shell.step.implicit import start
+
+SLOPE = (-np.sin(0.3), 0.0, np.cos(0.3))  # a ground's normal, tilted 0.3 rad about y
 
 
 def small_model(subdivisions=1, pressure=1e4, gas_exponent=1.4, **kwargs):
@@ -14,6 +19,25 @@ def small_model(subdivisions=1, pressure=1e4, gas_exponent=1.4, **kwargs):
     rng = np.random.default_rng(0)
     x = model.rest + 0.01 * rng.standard_normal(model.rest.shape)
     return model, build_workspace(model), x
+
+
+def pressed_step(integrator="generalized_alpha", seed=3):
+    """A small shell pressed on a ground tilted by ``SLOPE``, moving and deforming, with damping and
+    friction, in a step of 1 ms: ``(method, step data, its Start, a Newton iterate x, the scene)``."""
+    shell = Shell(subdivisions=1, pressure=20e3, position=(0, 0, 0))
+    rng = np.random.default_rng(seed)
+    x0 = build_model(shell).rest + 2e-4 * rng.standard_normal((42, 3))
+    height = float((x0 @ np.array(SLOPE)).min()) - 1e-3
+    scene = Scene(
+        shells=[shell], grounds=[Ground(normal=SLOPE, height=height, friction=0.4)],
+        integrator=integrator, damping=40.0, contact_distance=2e-2, friction_velocity=0.05,
+    )  # fmt: skip
+    method, (st,) = build(scene)
+    v0 = np.array([0.3, 0.1, -0.2]) + 0.05 * rng.standard_normal((42, 3))
+    a0 = rng.standard_normal((42, 3))
+    sp = start(method, st, x0, v0, a0, 1e-3)
+    x = x0 + 1e-3 * v0 + 2e-5 * rng.standard_normal((42, 3))
+    return method, st, sp, x, scene
 
 
 def assemble_dense(elements, mats, n_vertices):

@@ -14,14 +14,12 @@ from ballenv.shell.step.implicit import (
     direction,
     incremental,
     incremental_gradient,
-    start,
     total_energy,
 )
 
-from ..conftest import central_gradient, relative_error
+from ..conftest import central_gradient, pressed_step, relative_error
 
 G = 9.81
-SLOPE = (-np.sin(0.3), 0.0, np.cos(0.3))
 
 
 def centre(mass, x):
@@ -31,20 +29,8 @@ def centre(mass, x):
 @pytest.fixture(scope="module", params=["generalized_alpha", "backward_euler"])
 def contact_step(request):
     """A small shell pressed on a tilted ground, moving and deforming, with damping and friction."""
-    shell = Shell(subdivisions=1, pressure=20e3, position=(0, 0, 0))
-    rng = np.random.default_rng(3)
-    x0 = build_model(shell).rest + 2e-4 * rng.standard_normal((42, 3))
-    height = float((x0 @ np.array(SLOPE)).min()) - 1e-3
-    scene = Scene(
-        shells=[shell], grounds=[Ground(normal=SLOPE, height=height, friction=0.4)],
-        integrator=request.param, damping=40.0, contact_distance=2e-2, friction_velocity=0.05,
-    )  # fmt: skip
-    method, (st,) = build(scene)
-    v0 = np.array([0.3, 0.1, -0.2]) + 0.05 * rng.standard_normal((42, 3))
-    a0 = rng.standard_normal((42, 3))
-    sp = start(method, st, x0, v0, a0, 1e-3)
+    method, st, sp, x, _ = pressed_step(request.param, seed=3)
     assert (sp.lam > 0).sum() >= 2  # some vertices pressed on the ground
-    x = x0 + 1e-3 * v0 + 2e-5 * rng.standard_normal((42, 3))
     return method, st, sp, x
 
 

@@ -7,35 +7,21 @@ import numpy as np
 import pytest
 
 from ballenv.shell import Ground, Scene, Shell, simulate
-from ballenv.shell.simulation import build
-from ballenv.shell.skin.model import build_model
 from ballenv.shell.solve import cg
 from ballenv.shell.step import relax
-from ballenv.shell.step.implicit import direction, incremental_gradient, start
+from ballenv.shell.step.implicit import direction, incremental_gradient
 
-from ..conftest import central_gradient, relative_error
-
-SLOPE = (-np.sin(0.3), 0.0, np.cos(0.3))
+from ..conftest import SLOPE, central_gradient, pressed_step, relative_error
 
 
 @pytest.fixture(scope="module")
 def pressed():
     """A small shell pressed on a tilted ground with friction, a Newton iterate of its step, and a
     vertex within the barrier that has a lagged friction force."""
-    shell = Shell(subdivisions=1, pressure=20e3, position=(0, 0, 0))
-    rng = np.random.default_rng(5)
-    x0 = build_model(shell).rest + 2e-4 * rng.standard_normal((42, 3))
-    height = float((x0 @ np.array(SLOPE)).min()) - 1e-3
-    scene = Scene(
-        shells=[shell], grounds=[Ground(normal=SLOPE, height=height, friction=0.4)],
-        damping=40.0, contact_distance=2e-2, friction_velocity=0.05,
-    )  # fmt: skip
-    method, (st,) = build(scene)
-    v0 = np.array([0.3, 0.1, -0.2]) + 0.05 * rng.standard_normal((42, 3))
-    sp = start(method, st, x0, v0, rng.standard_normal((42, 3)), 1e-3)
-    x = x0 + 1e-3 * v0 + 2e-5 * rng.standard_normal((42, 3))
+    method, st, sp, x, scene = pressed_step(seed=5)
     i = int(np.argmax(sp.lam[:, 0]))
-    assert sp.lam[i, 0] > 0 and x[i] @ np.array(SLOPE) - height < scene.contact_distance
+    gap = x[i] @ np.array(SLOPE) - scene.grounds[0].height
+    assert sp.lam[i, 0] > 0 and gap < scene.contact_distance
     return method, st, sp, x, i
 
 
