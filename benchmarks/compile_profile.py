@@ -1,7 +1,8 @@
 """Where the first run's compile time goes, kernel by kernel: numba's compiler passes timed through
 its event API (``numba:run_pass``) in a process on an empty cache (``NUMBA_CACHE_DIR``), for the
-env's first steps (make, reset and three steps of ``InflatedBall-v3``) and for the first
-``simulate()`` of one ring on a floor (``Scene``'s defaults, 20 ms).
+env's first steps (make, reset and three steps of ``InflatedBall-v3``), for the 3-D paddle env's
+(``InflatedBall3DPaddle-v0``) and for the first ``simulate()`` of one ring on a floor (``Scene``'s
+defaults, 20 ms).
 
 Each scenario runs twice in the same minute: as the package compiles (machine code only for the
 entry points Python calls, ``ballenv/physics/base/machine_code.py``) and with numba's own code
@@ -83,6 +84,14 @@ SCENARIOS = {
 import gymnasium as gym
 import ballenv  # noqa: F401
 env = gym.make("InflatedBall-v3")
+env.reset(seed=0)
+for _ in range(3):
+    env.step(env.action_space.sample())
+""",
+    "env3d": """
+import gymnasium as gym
+import ballenv  # noqa: F401
+env = gym.make("InflatedBall3DPaddle-v0")
 env.reset(seed=0)
 for _ in range(3):
     env.step(env.action_space.sample())
