@@ -3,12 +3,12 @@ that touches a ground moves, the others held, to the minimiser of its part of ``
 
 A vertex pressed on a ground carries the stiffest and least smooth terms of the incremental
 potential: the barrier ``B`` (ground.py), steep near the ground, and the lagged friction ``D``
-(friction.py), whose stiffness below the smoothing slip ``e = eps_v h`` is ``2 mu lambda / e``, for
-a 1 ms step about a thousand times the vertex's mass term. A Newton correction of the whole skin
+(friction.py), whose stiffness below the smoothing slip ``e = eps_v h`` is ``2 mu lambda / e``
+(N/m): on the default ball pressed by tens of newtons at sub-millisecond steps, about a thousand
+times the vertex's mass term ``c_M m_i``. A Newton correction of the whole skin
 that moves such a vertex across ``e`` (about a micrometre) finds a friction force its quadratic model
-did not expect, and the line search cuts the whole correction for that one vertex: measured on the
-paddle env's steps in contact, 14 Newton iterations of a first friction round against 3 without
-friction (``benchmarks/results/env3d_throughput.md``).
+did not expect, and the line search cuts the whole correction for that one vertex (the
+measurements: docs/notes/benchmarks.md, "The contact vertices' own descent").
 
 So before each Newton correction after the first, each contact vertex ``i`` descends on its own
 model (N, m; ``delta`` its move, the others fixed)::
