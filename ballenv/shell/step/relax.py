@@ -27,7 +27,6 @@ vertex. ``H_i`` models the skin, so the moves are kept only if ``Phi`` itself dr
 import math
 
 from ...physics.base.jit import kernel
-from ...physics.walls.self_barrier import beta
 from ..rest.equilibrium import ARMIJO, HALVINGS
 from ..touch import friction, ground
 
@@ -59,7 +58,7 @@ def vertex_contact(st, sp, x, i, e, grad, hess, u):
         if d <= 0.0:
             return math.inf
         if d < dhat:
-            total += st.kappa * dhat * dhat * beta(d * d / (dhat * dhat))
+            total += ground.barrier(d, dhat, st.kappa)
             slope, curvature = ground.barrier_derivatives(d, dhat, st.kappa)
             for a in range(3):
                 grad[0, a] += slope * n[a]

@@ -32,6 +32,12 @@ def distance(x, i, normals, heights, g):
 
 
 @kernel(inline="always")
+def barrier(d, dhat, kappa):
+    """``B`` (J) of a vertex at distance ``0 < d < dhat`` (m) (module doc)."""
+    return kappa * dhat * dhat * beta(d * d / (dhat * dhat))
+
+
+@kernel(inline="always")
 def barrier_derivatives(d, dhat, kappa):
     """``(dB/dd (N), d^2B/dd^2 (N/m))`` of a vertex at distance ``0 < d < dhat`` (m) (module doc)."""
     y = d * d / (dhat * dhat)
@@ -46,7 +52,7 @@ def barrier_energy(x, normals, heights, dhat, kappa):
         for i in range(x.shape[0]):
             d = distance(x, i, normals, heights, g)
             if d < dhat:
-                total += kappa * dhat * dhat * beta(d * d / (dhat * dhat)) if d > 0.0 else math.inf
+                total += barrier(d, dhat, kappa) if d > 0.0 else math.inf
     return total
 
 
