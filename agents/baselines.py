@@ -78,12 +78,12 @@ class ModelPolicy:
     def act(self, obs: NDArray[np.float32]) -> NDArray[np.float32]:
         plays = getattr(self.wrapper, "act", None)  # a wrapper that plays the env step by step
         if plays is not None:
-            return np.asarray(plays(obs, self.decide), dtype=np.float32).reshape(1)
+            return np.asarray(plays(obs, self.decide), dtype=np.float32).reshape(self.shape)
         if self.wrapper is not None:
             obs = self.wrapper.observation(obs)
         action = self.decide(obs)
         to_env = getattr(self.wrapper, "action", None)  # a wrapper that also acts (ResidualPump)
-        return action if to_env is None else np.asarray(to_env(action), dtype=np.float32).reshape(1)
+        return action if to_env is None else np.asarray(to_env(action), dtype=np.float32).reshape(self.shape)
 
     def decide(self, obs: NDArray[np.float32]) -> NDArray[np.float32]:
         """The model's deterministic action for a wrapped observation (normalised here, if the run

@@ -36,9 +36,9 @@ PACKAGE_LAYERS = (
 NUMERICS_ONLY = ("gymnasium", "torch", "pygame", "matplotlib", "stable_baselines3", "PIL")
 # what agents may import of ballenv: the env's public modules, never the simulator's internals
 AGENTS_MAY_IMPORT = (
-    "ballenv", "ballenv.envs", "ballenv.envs.inflated_ball", "ballenv.envs.ball3d.env", "ballenv.envs.config",
-    "ballenv.envs.observation", "ballenv.envs.task", "ballenv.controllers", "ballenv.cluster",
-    "ballenv.extras", "ballenv.files", "ballenv.physics",
+    "ballenv", "ballenv.envs", "ballenv.envs.inflated_ball", "ballenv.envs.ball3d.env",
+    "ballenv.envs.ball3d.body", "ballenv.envs.config", "ballenv.envs.observation", "ballenv.envs.task",
+    "ballenv.controllers", "ballenv.cluster", "ballenv.extras", "ballenv.files", "ballenv.physics",
 )  # fmt: skip
 
 

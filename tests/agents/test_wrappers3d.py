@@ -1,0 +1,100 @@
+"""agents.wrappers3d.PaddleStrike3D: one agent step a strike of the dribbler, corrected by the agent;
+a zero correction is the dribbler to the bit; its rewards are the apexes' combined errors that
+agents.evaluate3d scores; a run of train.py behind it is scored by agents.evaluate3d."""
+
+import gymnasium as gym
+import numpy as np
+import pytest
+import yaml
+
+from agents.evaluate3d import evaluate3d, run_episode
+from agents.policies import Heuristic3DPolicy
+from agents.train import parse_args, train
+from agents.wrappers3d import CORRECTION, IDLE, PaddleStrike3D
+
+STEPS = 300  # control steps per episode: about four strikes
+SHORT = {"action_mode": "paddle", "max_episode_steps": STEPS}
+
+
+def wrapped(**kwargs):
+    return PaddleStrike3D(gym.make("ballenv:InflatedBall3DPaddle-v0", max_episode_steps=STEPS, **kwargs))
+
+
+class Playing:
+    """A policy that plays ``PaddleStrike3D`` with a fixed correction (the agent's action)."""
+
+    name = "fixed correction"
+
+    def __init__(self, env, correction):
+        self.wrapper, self.correction = PaddleStrike3D(env), np.asarray(correction, dtype=np.float32)
+
+    def reset(self, seed):
+        self.wrapper.restart()
+
+    def act(self, obs):
+        return self.wrapper.act(obs, lambda wrapped_obs: self.correction)
+
+
+def test_a_zero_correction_plays_the_dribbler_to_the_bit():
+    dribbler = evaluate3d("heuristic", SHORT, episodes=2, seed=10_000)
+    zero = evaluate3d(lambda env: Playing(env, np.zeros(3)), SHORT, episodes=2, seed=10_000)
+    assert zero.combined_errors == dribbler.combined_errors and zero.lengths == dribbler.lengths
+    assert min(dribbler.apexes) >= 3
+
+
+def test_each_agent_step_is_one_strike_of_the_dribblers_action_plus_the_correction():
+    env = wrapped()
+    obs, _ = env.reset(seed=3)
+    assert env.observation_space.contains(obs) and obs.shape == (env.observation_space.shape[0],)
+    base = env.base.copy()
+    assert base[0] > -1.0  # a decision: the dribbler strikes
+    np.testing.assert_array_equal(obs[-3:], base)
+    action = np.array([1.0, -1.0, 0.5], dtype=np.float32)
+    played = env.strike(action)
+    np.testing.assert_allclose(played, np.clip(base + CORRECTION * action, -1.0, 1.0), rtol=0, atol=1e-7)
+    taken = []  # the env actions the wrapper plays in one agent step
+    inner_step = env.env.step
+    env.env.step = lambda a: taken.append(np.array(a)) or inner_step(a)
+    _, _, terminated, truncated, _ = env.step(action)
+    np.testing.assert_array_equal(taken[0], played)
+    assert len(taken) > 10 and all(np.array_equal(a, IDLE) for a in taken[1:])  # idle to the next decision
+    assert terminated or truncated or env.base[0] > -1.0
+
+
+def test_its_rewards_are_the_apex_errors_agents_evaluate3d_scores():
+    """A zero correction: each agent step's reward is minus the combined error of the apex after
+    its strike, as agents.evaluate3d scores that apex (the apexes before the first strike, which
+    no agent's action sets, are in the score only)."""
+    env = wrapped()
+    env.reset(seed=10_000)
+    costs = []
+    while True:
+        _, reward, terminated, truncated, info = env.step(np.zeros(3, dtype=np.float32))
+        costs.append(-float(reward))
+        if terminated or truncated:
+            break
+    assert truncated and costs[-1] == 0.0  # the time limit came before the last strike's apex
+    scored = gym.make("ballenv:InflatedBall3DPaddle-v0", max_episode_steps=STEPS)
+    heights, spots, _, _ = run_episode(scored, Heuristic3DPolicy(scored), 10_000)
+    errors = [h / 0.5 + d / 0.3 for h, d in zip(heights, spots, strict=True)]
+    assert len(costs) - 1 >= 3 and len(errors) > len(costs) - 1
+    np.testing.assert_allclose(costs[:-1], errors[-(len(costs) - 1) :], rtol=1e-12, atol=0)
+
+
+def test_the_pressure_mode_is_refused_naming_the_action_mode():
+    with pytest.raises(ValueError, match="action_mode = 'pressure' is invalid"):
+        PaddleStrike3D(gym.make("ballenv:InflatedBall3D-v0"))
+
+
+def test_a_sac_run_behind_it_trains_and_is_scored_strike_by_strike(tmp_path):
+    args = parse_args([
+        "--algo", "sac", "--action-mode", "paddle3d", "--conf-file", "sac_strike3d", "--n-envs", "1",
+        "--total-timesteps", "12", "--eval-freq", "6", "--eval-episodes", "1", "--final-episodes", "0",
+        "--log-dir", str(tmp_path), "--env-kwargs", '{"max_episode_steps": 400}',
+        "--hyperparams", '{"learning_starts": 4, "batch_size": 4, "buffer_size": 100}',
+    ])  # fmt: skip
+    run = train(args)
+    config = yaml.safe_load((run / "config.yml").read_text())
+    assert config["env_wrapper"] == "agents.wrappers3d.PaddleStrike3D"
+    score = evaluate3d(str(run), {"action_mode": "paddle", "max_episode_steps": 400}, episodes=1)
+    assert score.lengths == (400,) and score.apexes[0] >= 4
