@@ -21,7 +21,9 @@ import os
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import argparse  # noqa: E402
+import json  # noqa: E402
 import pathlib  # noqa: E402
+import re  # noqa: E402
 import time  # noqa: E402
 from concurrent.futures import ProcessPoolExecutor  # noqa: E402
 
@@ -55,6 +57,21 @@ def interval(runs: list[tuple[float, ...]]) -> str:
     return f"{iqm(np.concatenate(runs)):.3f} [{low:.3f}, {high:.3f}]"
 
 
+def compare(reference: list[tuple[float, ...]], runs: list[tuple[float, ...]]) -> str:
+    """Whether the trained ``runs``' combined errors are below, above or not apart from the
+    dribbler's (``reference``): their 95 % intervals compared."""
+    low, high = bootstrap_iqm([np.asarray(r) for r in runs])
+    ref_low, ref_high = bootstrap_iqm([np.asarray(r) for r in reference])
+    if high < ref_low:
+        return "The trained agents beat the dribbler: their interval lies below the dribbler's."
+    if low > ref_high:
+        return "The dribbler beats the trained agents: their interval lies above the dribbler's."
+    return (
+        f"The intervals overlap ({low:.3f}-{high:.3f} against {ref_low:.3f}-{ref_high:.3f}): the trained "
+        "agents do not beat the dribbler."
+    )
+
+
 def curves(runs: list[pathlib.Path], out: pathlib.Path) -> list[str]:
     """Each run's periodic evaluations (mean return by strikes) as lines of the page, drawn to ``out``."""
     import matplotlib
@@ -68,8 +85,11 @@ def curves(runs: list[pathlib.Path], out: pathlib.Path) -> list[str]:
         log = np.load(run / "evaluations.npz")
         means = log["results"].mean(axis=1)
         ax.plot(log["timesteps"], means, marker="o", label=run.name)
-        points = ", ".join(f"{int(t)}: {r:.2f}" for t, r in zip(log["timesteps"], means, strict=True))
-        lines.append(f"- `{run.name}`: {points}")
+        points = ", ".join(f"{int(t)}: {r:.1f}" for t, r in zip(log["timesteps"], means, strict=True))
+        state = run / "resume" / "state.json"  # a run stopped by Ctrl-C (train.py) says where
+        done = json.loads(state.read_text())["num_timesteps"] if state.exists() else None
+        stopped = f"; stopped at {done} strikes" if done else ""
+        lines.append(f"- `{run.name}`: {points}{stopped}")
     ax.set_xlabel("strikes (agent steps)")
     ax.set_ylabel("mean evaluation return (env reward)")
     ax.set_title("SAC behind PaddleStrike3D, InflatedBall3DPaddle-v0")
@@ -104,14 +124,19 @@ def clip(run: pathlib.Path, out: pathlib.Path, seconds: float) -> None:
     env.close()
 
 
-def main() -> None:
+def build_parser() -> argparse.ArgumentParser:
+    """The command line of ``python benchmarks/ball3d_strike.py``."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("runs", nargs="+", type=pathlib.Path, help="train.py run folders")
     parser.add_argument("--episodes", type=int, default=100, help="held-out episodes per policy")
     parser.add_argument("--max-episode-steps", type=int, default=500, help="time limit (control steps)")
     parser.add_argument("--workers", type=int, default=2, help="policies scored at once")
     parser.add_argument("--clip-seconds", type=float, default=6.0)
-    args = parser.parse_args()
+    return parser
+
+
+def main() -> None:
+    args = build_parser().parse_args()
     policies = ["heuristic"] + [str(r) for r in args.runs]
     with ProcessPoolExecutor(args.workers) as pool:
         results = list(
@@ -135,11 +160,12 @@ def main() -> None:
     curve = curves(args.runs, ROOT / "docs" / "learning_curve_strike3d.png")
     clip(args.runs[0], ROOT / "docs" / "figures" / "strike3d.mp4", args.clip_seconds)
     command = (args.runs[0] / "command.txt").read_text().strip().splitlines()[-1]
-    command = "python " + command[command.index("train.py") :]
+    command = re.sub(r"--log-dir \S+", "--log-dir RUNS", "python " + command[command.index("train.py") :])
+    verdict = compare([dribbler[1]], [g[1] for g in trained])
     page = [
         "# Trained agents against the 3-D dribbler",
         "",
-        f"`python benchmarks/ball3d_strike.py {' '.join(str(r) for r in args.runs)} --episodes "
+        f"`python benchmarks/ball3d_strike.py {' '.join('RUNS/' + r.name for r in args.runs)} --episodes "
         f"{args.episodes} --max-episode-steps {args.max_episode_steps}`: "
         f"InflatedBall3DPaddle-v0 (fast preset, 162 vertices), {args.episodes} held-out episodes (seeds "
         f"10000 on) of at most {args.max_episode_steps} control steps per policy.",
@@ -154,6 +180,8 @@ def main() -> None:
         "distance IQM [95 % CI] (m) | wall time (s) |",
         "|---|---:|---:|---:|---:|---:|",
         *rows,
+        "",
+        verdict,
         "",
         "Learning curves: the periodic evaluations' mean return by strikes trained (the env's own "
         "reward summed over an episode of its 1000-step time limit, what picks the best model; "

@@ -3,13 +3,13 @@ or checked.
 
 Python blocks run, in order, in one namespace per file (a later block may use an earlier one's
 names), in a temporary folder. Each command of a shell block is checked without running it:
-``make X`` is a target of the Makefile (``make -n``); ``python train.py`` and ``python -m
-agents.evaluate`` / ``study`` / ``tune`` / ``imitation`` parse with those modules' own argument parsers; ``pip
-install`` installs this checkout (``-e .[EXTRAS]``, extras that exist) with a constraints file that
-exists, and takes packages from no index but PyPI and PyTorch's CPU-only one. A block of another
-language, or a command no check knows, fails: a new block needs a check here, or an entry in
-``EXEMPT`` with the reason. The Guide's pages of commands only (``SHELL_DOCUMENTS``) are checked
-the same way.
+``make X`` is a target of the Makefile (``make -n``); ``python train.py``, ``python -m
+agents.evaluate`` / ``study`` / ``tune`` / ``imitation`` and ``python benchmarks/ball3d_strike.py``
+parse with those modules' own argument parsers; ``pip install`` installs this checkout (``-e
+.[EXTRAS]``, extras that exist) with a constraints file that exists, and takes packages from no
+index but PyPI and PyTorch's CPU-only one. A block of another language, or a command no check
+knows, fails: a new block needs a check here, or an entry in ``EXEMPT`` with the reason. The
+Guide's pages of commands only (``SHELL_DOCUMENTS``) are checked the same way.
 """
 
 import re
@@ -93,6 +93,15 @@ def check_study_or_tune(module):
     return check
 
 
+def check_benchmark(name):
+    def check(args):
+        from tests.benchmark_modules import load_benchmark
+
+        load_benchmark(name).build_parser().parse_args(args)
+
+    return check
+
+
 def pyproject_extras():
     """The names of the optional dependencies (extras) in pyproject.toml."""
     text = (ROOT / "pyproject.toml").read_text()
@@ -144,6 +153,7 @@ def checker(argv):
         ("python", "-m", "agents.tune"): check_study_or_tune(agents.tune),
         ("python", "-m", "agents.imitation"): check_imitation,
         ("pip", "install"): check_pip_install,
+        ("python", "benchmarks/ball3d_strike.py"): check_benchmark("ball3d_strike"),
     }
     for prefix, check in prefixes.items():
         if tuple(argv[: len(prefix)]) == prefix:

@@ -1,6 +1,7 @@
 """agents.wrappers3d.PaddleStrike3D: one agent step a strike of the dribbler, corrected by the agent;
 a zero correction is the dribbler to the bit; its rewards are the apexes' combined errors that
-agents.evaluate3d scores; a run of train.py behind it is scored by agents.evaluate3d."""
+agents.evaluate3d scores; a run of train.py behind it is scored by agents.evaluate3d; and
+benchmarks/ball3d_strike.py's verdict and learning curves."""
 
 import gymnasium as gym
 import numpy as np
@@ -11,6 +12,7 @@ from agents.evaluate3d import evaluate3d, run_episode
 from agents.policies import Heuristic3DPolicy
 from agents.train import parse_args, train
 from agents.wrappers3d import CORRECTION, IDLE, PaddleStrike3D
+from tests.benchmark_modules import load_benchmark
 
 STEPS = 300  # control steps per episode: about four strikes
 SHORT = {"action_mode": "paddle", "max_episode_steps": STEPS}
@@ -98,3 +100,23 @@ def test_a_sac_run_behind_it_trains_and_is_scored_strike_by_strike(tmp_path):
     assert config["env_wrapper"] == "agents.wrappers3d.PaddleStrike3D"
     score = evaluate3d(str(run), {"action_mode": "paddle", "max_episode_steps": 400}, episodes=1)
     assert score.lengths == (400,) and score.apexes[0] >= 4
+
+
+def test_the_benchmark_says_beat_only_when_the_intervals_are_apart(tmp_path):
+    bench = load_benchmark("ball3d_strike")
+    rng = np.random.default_rng(0)
+    dribbler = [tuple(0.26 + 0.02 * rng.standard_normal(100))]
+    better = [tuple(0.15 + 0.02 * rng.standard_normal(100)) for _ in range(3)]
+    same = [tuple(0.26 + 0.02 * rng.standard_normal(100)) for _ in range(3)]
+    worse = [tuple(0.40 + 0.02 * rng.standard_normal(100)) for _ in range(3)]
+    assert bench.compare(dribbler, better).startswith("The trained agents beat the dribbler")
+    assert "do not beat the dribbler" in bench.compare(dribbler, same)
+    assert bench.compare(dribbler, worse).startswith("The dribbler beats the trained agents")
+    run = tmp_path / "sac_paddle3d_seed4"
+    (run / "resume").mkdir(parents=True)
+    returns = np.array([[1.0, 3.0], [5.0, 5.0]])  # two evaluations of two episodes
+    np.savez(run / "evaluations.npz", timesteps=np.array([10, 20]), results=returns)
+    (run / "resume" / "state.json").write_text('{"num_timesteps": 25}')
+    lines = bench.curves([run], tmp_path / "curve.png")
+    assert lines == ["- `sac_paddle3d_seed4`: 10: 2.0, 20: 5.0; stopped at 25 strikes"]
+    assert (tmp_path / "curve.png").stat().st_size > 0
