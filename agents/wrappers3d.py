@@ -35,9 +35,8 @@ from ballenv.envs.ball3d.env import ball3d_env
 
 from .policies import Heuristic3DPolicy
 
-CORRECTION = np.array(
-    [0.05, 0.15, 0.15]
-)  # the correction's full range: impulse, x tilt, y tilt (action units)
+# the correction's full range in action units: impulse, x tilt, y tilt
+CORRECTION = np.array([0.05, 0.15, 0.15])
 IDLE = np.array([-1.0, 0.0, 0.0], dtype=np.float32)  # the paddle's action between strikes
 RESET_TRIES = 20  # episodes a reset may start before one reaches a decision
 
@@ -55,7 +54,7 @@ class PaddleStrike3D(BodyObservation):
                 "PaddleStrike3D: action_mode = 'pressure' is invalid: it corrects the paddle's strike, "
                 "valid: 'paddle' (InflatedBall3DPaddle-v0)"
             )
-        self.config, self.inner = inner.config, inner.observation_structure
+        self.config = inner.config
         self.scripted = Heuristic3DPolicy(env)
         self.limit = env.spec.max_episode_steps if env.spec and env.spec.max_episode_steps else None
         self.action_space = gym.spaces.Box(-1.0, 1.0, (3,), dtype=np.float32)
@@ -81,7 +80,7 @@ class PaddleStrike3D(BodyObservation):
     def decide(self, observation: NDArray[np.float32]) -> bool:
         """Whether ``observation`` (the env's) is a decision: the ball in reach and the dribbler
         striking (it idles while the ball is too high for its strike); its strike then in ``base``."""
-        if observation[self.inner["paddle_in_reach"]][0] <= 0.5:
+        if observation[self.inner_structure["paddle_in_reach"]][0] <= 0.5:
             return False
         strike = np.asarray(self.scripted.act(observation), dtype=np.float32)
         if strike[0] <= -1.0:
@@ -135,8 +134,8 @@ class PaddleStrike3D(BodyObservation):
         """The combined error of the apex of ``info`` (a missed one: height error 1) at the centre's
         present distance to the spot (module doc)."""
         c = self.config
-        centre = self.raw[self.inner["centre_of_mass_position"]][:2]
-        distance = float(np.hypot(*(centre - self.raw[self.inner["target_spot"]])))
+        centre = self.raw[self.inner_structure["centre_of_mass_position"]][:2]
+        distance = float(np.hypot(*(centre - self.raw[self.inner_structure["target_spot"]])))
         height = 1.0 if missed else abs(info["apex_height"] - info["target_height"]) / info["target_height"]
         return height / c.reward_margin + distance / c.spot_margin
 
