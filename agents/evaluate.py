@@ -32,12 +32,11 @@ import os
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import asdict, dataclass
 from statistics import NormalDist
-from typing import Any
+from typing import Any, Protocol
 
 import gymnasium as gym
 import numpy as np
 
-from ballenv.envs.config import BallEnvConfig
 from ballenv.envs.inflated_ball import ball_env
 from ballenv.files import write_text
 
@@ -87,7 +86,17 @@ def run_episode(env: gym.Env[Any, Any], policy: Policy, seed: int) -> tuple[list
             return errors, missed, length, total
 
 
-def missed_apexes(config: BallEnvConfig, target: float, time_left: float) -> int:
+class Bouncing(Protocol):
+    """What :func:`missed_apexes` reads of an env's config (the ring's or the 3-D ball's)."""
+
+    @property
+    def radius(self) -> float: ...  # m
+
+    @property
+    def gravity(self) -> float: ...  # m/s^2
+
+
+def missed_apexes(config: Bouncing, target: float, time_left: float) -> int:
     """Apexes a ball bouncing to ``target`` (m) would reach in ``time_left`` (s): one per flight
     time ``2 sqrt(2 (target - R) / g)``, ``R`` the unstretched radius (the centre of a resting ball
     is about that high)."""

@@ -23,7 +23,6 @@ flight time ``2 sqrt(2 (h_t - R) / g)`` left until the time limit, as ``agents.e
 from __future__ import annotations
 
 import argparse
-import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -33,9 +32,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ballenv.envs import BALL3D_ENV_IDS
+from ballenv.envs.ball3d.config import Ball3DConfig
 from ballenv.envs.ball3d.env import ball3d_env
 
 from .baselines import ModelPolicy
+from .evaluate import missed_apexes
 from .policies import Heuristic3DPolicy, IdlePolicy, Policy, RandomPolicy
 
 DEFAULT_SEED = 10_000
@@ -75,22 +76,27 @@ def run_episode(
     while True:
         obs, reward, terminated, truncated, info = env.step(policy.act(obs))
         total, length = total + float(reward), length + 1
-        distance = _spot_distance(obs, structure) if config.paddle else 0.0
+        distance = spot_distance(obs, structure) if config.paddle else 0.0
         if info["apex_count"]:
             heights.append(abs(info["apex_height"] - info["target_height"]) / info["target_height"])
             spots.append(distance)
         if terminated and limit:
-            flight = 2.0 * math.sqrt(2.0 * max(info["target_height"] - config.radius, 1e-3) / config.gravity)
-            missed = int(round(max(limit - length, 0) * config.control_dt / flight))
+            missed = missed_apexes(config, info["target_height"], (limit - length) * config.control_dt)
             heights, spots = heights + [1.0] * missed, spots + [distance] * missed
         if terminated or truncated:
             return heights, spots, length, total
 
 
-def _spot_distance(obs: NDArray[np.float32], structure: dict[str, slice]) -> float:
+def spot_distance(obs: NDArray[np.float32], structure: dict[str, slice]) -> float:
     """The centre's horizontal distance (m) to the target spot in observation ``obs``."""
     offset = obs[structure["centre_of_mass_position"]][:2] - obs[structure["target_spot"]]
     return float(np.hypot(*offset))
+
+
+def combined_error(config: Ball3DConfig, height: float, distance: float) -> float:
+    """The combined error of a relative ``height`` error and a spot ``distance`` (m) (module doc;
+    the distance counts in paddle mode only)."""
+    return height / config.reward_margin + (distance / config.spot_margin if config.paddle else 0.0)
 
 
 def evaluate3d(
@@ -113,7 +119,7 @@ def evaluate3d(
         heights, spots, length, total = run_episode(env, agent, s)
         h = float(np.mean(heights)) if heights else 1.0
         d = float(np.mean(spots)) if spots else 0.0
-        combined = h / config.reward_margin + (d / config.spot_margin if config.paddle else 0.0)
+        combined = combined_error(config, h, d)
         rows.append((h, d, combined, len(heights), length, total))
     env.close()
     columns = list(zip(*rows, strict=True))

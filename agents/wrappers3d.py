@@ -23,7 +23,6 @@ and ``b``.
 
 from __future__ import annotations
 
-import math
 from typing import Any, SupportsFloat
 
 import gymnasium as gym
@@ -33,6 +32,8 @@ from numpy.typing import NDArray
 from ballenv.envs.ball3d.body import BodyObservation
 from ballenv.envs.ball3d.env import ball3d_env
 
+from .evaluate import missed_apexes
+from .evaluate3d import combined_error, spot_distance
 from .policies import Heuristic3DPolicy
 
 # the correction's full range in action units: impulse, x tilt, y tilt
@@ -133,19 +134,16 @@ class PaddleStrike3D(BodyObservation):
     def apex_error(self, info: dict[str, Any], missed: bool = False) -> float:
         """The combined error of the apex of ``info`` (a missed one: height error 1) at the centre's
         present distance to the spot (module doc)."""
-        c = self.config
-        centre = self.raw[self.inner_structure["centre_of_mass_position"]][:2]
-        distance = float(np.hypot(*(centre - self.raw[self.inner_structure["target_spot"]])))
         height = 1.0 if missed else abs(info["apex_height"] - info["target_height"]) / info["target_height"]
-        return height / c.reward_margin + distance / c.spot_margin
+        return combined_error(self.config, height, spot_distance(self.raw, self.inner_structure))
 
     def missed(self, info: dict[str, Any]) -> int:
         """The flights left until the time limit when an episode ends early (``agents.evaluate3d``)."""
         if not self.limit:
             return 1
-        c = self.config
-        flight = 2.0 * math.sqrt(2.0 * max(info["target_height"] - c.radius, 1e-3) / c.gravity)
-        return int(round(max(self.limit - self.steps, 0) * c.control_dt / flight))
+        return missed_apexes(
+            self.config, info["target_height"], (self.limit - self.steps) * self.config.control_dt
+        )
 
     def act(self, observation: NDArray[np.float32], ask: Any) -> NDArray[np.float32]:
         """The env's action for its ``observation``, one env step at a time: at a decision the

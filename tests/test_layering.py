@@ -37,8 +37,9 @@ NUMERICS_ONLY = ("gymnasium", "torch", "pygame", "matplotlib", "stable_baselines
 # what agents may import of ballenv: the env's public modules, never the simulator's internals
 AGENTS_MAY_IMPORT = (
     "ballenv", "ballenv.envs", "ballenv.envs.inflated_ball", "ballenv.envs.ball3d.env",
-    "ballenv.envs.ball3d.body", "ballenv.envs.config", "ballenv.envs.observation", "ballenv.envs.task",
-    "ballenv.controllers", "ballenv.cluster", "ballenv.extras", "ballenv.files", "ballenv.physics",
+    "ballenv.envs.ball3d.body", "ballenv.envs.ball3d.config", "ballenv.envs.config",
+    "ballenv.envs.observation", "ballenv.envs.task", "ballenv.controllers", "ballenv.cluster",
+    "ballenv.extras", "ballenv.files", "ballenv.physics",
 )  # fmt: skip
 
 

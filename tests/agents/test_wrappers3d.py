@@ -60,7 +60,8 @@ def test_each_agent_step_is_one_strike_of_the_dribblers_action_plus_the_correcti
     _, _, terminated, truncated, _ = env.step(action)
     np.testing.assert_array_equal(taken[0], played)
     assert len(taken) > 10 and all(np.array_equal(a, IDLE) for a in taken[1:])  # idle to the next decision
-    assert terminated or truncated or env.base[0] > -1.0
+    in_reach = env.inner_structure["paddle_in_reach"]
+    assert terminated or truncated or env.raw[in_reach][0] > 0.5  # it stopped at the next decision
 
 
 def test_its_rewards_are_the_apex_errors_agents_evaluate3d_scores():
