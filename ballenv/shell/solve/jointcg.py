@@ -18,7 +18,7 @@ from . import cg
 @kernel
 def apply(sts, jt, x, y):
     """``y = A x`` (S, V, 3) (module doc)."""
-    for k in range(len(sts)):
+    for k in range(x.shape[0]):
         cg.apply(sts[k].op, x[k], y[k])
     n = x.shape[0] * x.shape[1]
     xf, yf = x.reshape((n, 3)), y.reshape((n, 3))
@@ -49,7 +49,7 @@ def _dot(a, b):
 def _precondition(sts, r, z):
     """``z = P r`` with each shell's block inverses; returns ``r . z``."""
     rz = 0.0
-    for k in range(len(sts)):
+    for k in range(r.shape[0]):
         inverses = sts[k].op.inverses
         for v in range(r.shape[1]):
             r0, r1, r2 = r[k, v, 0], r[k, v, 1], r[k, v, 2]
@@ -64,7 +64,7 @@ def pcg(sts, jt, rhs, x, rtol, max_iter):
     """CG on ``A x = rhs`` (S, V, 3) from ``x = 0`` with ``jt.cg`` as scratch. Returns the
     iterations taken, or -1 if ``max_iter`` was reached first."""
     r, p, q, z = jt.cg[0], jt.cg[1], jt.cg[2], jt.cg[3]
-    for k in range(len(sts)):
+    for k in range(x.shape[0]):
         cg.block_inverses(sts[k].op, sts[k].problem.free, sts[k].op.inverses)
     x[:] = 0.0
     copy_into(r, rhs)

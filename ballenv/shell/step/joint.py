@@ -17,11 +17,13 @@ normal forces are lagged as there. The contact between shells is frictionless.
 """
 
 import math
+from typing import TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ...physics.base.jit import copy_into, kernel
+from ...physics.base.record_ref import reference
 from ..rest.equilibrium import ARMIJO, HALVINGS
 from ..solve import jointcg, stepsolve
 from ..touch import broadphase, contact, drums, ground
@@ -30,6 +32,8 @@ from .jointdata import Joint
 from .stepdata import ShellStep
 
 F64 = NDArray[np.float64]
+R = TypeVar("R")
+SHARED_GROUP = 2  # the shortest tuple of shells the compiled step takes (padded)
 FAILURES = dict(implicit.FAILURES)
 FAILURES[5] = "more contact pairs than their records hold"
 FAILURES[6] = "a joint CG that did not converge"
@@ -49,7 +53,7 @@ def flat(a):
 def energy(method, sts, jt, x):
     """Phi(x) (J) of the module doc, inf where a vertex reaches a ground or a triangle."""
     total = 0.0
-    for k in range(len(sts)):
+    for k in range(jt.x.shape[0]):
         total += increment.incremental(method, sts[k], sts[k].start, x[k], sts[k].work)
     if not math.isfinite(total):
         return total
@@ -61,7 +65,7 @@ def energy(method, sts, jt, x):
 def gradient(method, sts, jt, x, grad, blocks, hessian):
     """``grad Phi`` (N) and the vertex blocks (N/m) at ``x``; with ``hessian`` the touching pairs'
     matrices into ``jt``. Returns the touching pairs, -1 if they do not fit."""
-    for k in range(len(sts)):
+    for k in range(jt.x.shape[0]):
         st = sts[k]
         increment.incremental_gradient(method, st, st.start, x[k], st.work, grad[k], blocks[k])
     cd = jt.candidates
@@ -93,16 +97,16 @@ def max_step(sts, jt, x, dx):
     if broadphase.find_pairs(cd, flat(x), flat(dx), jt.dhat, jt.box) < 0:
         return -1.0
     alpha = 1.0
-    for k in range(len(sts)):
+    for k in range(jt.x.shape[0]):
         alpha = min(alpha, ground.max_step(x[k], dx[k], sts[k].normals, sts[k].heights))
         alpha = min(alpha, drums.max_step(sts[k].drums, x[k], dx[k]))
     return contact.max_step(cd.pairs, cd.n_pairs[0], flat(x), flat(dx), alpha, jt.scratch)
 
 
 @kernel
-def _rounding(sts, e0):
+def _rounding(sts, jt, e0):
     out = 1e-13 * abs(e0)
-    for k in range(len(sts)):
+    for k in range(jt.x.shape[0]):
         model = sts[k].problem.model
         out += 1e-13 * model.absolute_pressure[0] * model.rest_volume
     return out
@@ -120,7 +124,7 @@ def search(method, sts, jt, e0, alpha):
                 slope += jt.grad[k, i, c] * dx[k, i, c]
                 g0 = max(g0, abs(jt.grad[k, i, c]))
     slope = abs(slope)
-    rounding = _rounding(sts, e0)
+    rounding = _rounding(sts, jt, e0)
     for _ in range(HALVINGS):
         for k in range(x.shape[0]):
             for i in range(x.shape[1]):
@@ -144,7 +148,7 @@ def _residual(method, sts, jt):
     gradient is not finite; and the force (N) the goals ask for, the smallest."""
     h = sts[0].start.coef[0]
     worst, force_goal = 0.0, math.inf
-    for k in range(len(sts)):
+    for k in range(jt.x.shape[0]):
         st = sts[k]
         mass = st.problem.model.mass
         goal = method.solver.newton_tol * (st.gravity + st.radius / (h * h))
@@ -160,7 +164,7 @@ def _residual(method, sts, jt):
 @kernel
 def direction(sts, jt, fresh, rtol):
     """Newton's correction (m) into ``jt.dx`` (jointcg.py); the CG iterations, -1 if it failed."""
-    for k in range(len(sts)):
+    for k in range(jt.x.shape[0]):
         st = sts[k]
         sp, wk = st.start, st.work
         c_x, s = increment.newton_matrix(st, sp, jt.x[k], wk, fresh)
@@ -208,7 +212,7 @@ def newton(method, sts, jt):
 def _start(method, sts, jt, x0, v0, a0, h):
     """Each shell's start (increment.begin) and the predictor, cut short of grounds and triangles,
     into ``jt.x``; False if the candidate pairs did not fit."""
-    for k in range(len(sts)):
+    for k in range(jt.x.shape[0]):
         st = sts[k]
         increment.begin(method, st, x0[k], v0[k], a0[k], h, st.start)
         for i in range(x0.shape[1]):
@@ -227,13 +231,13 @@ def _lags_changed(sts, jt):
     """Friction's normal forces at ``jt.x``: True (and taken as the lagged ones) if one of a shell
     changed by more than implicit.LAG_TOL of its weight."""
     changed = False
-    for k in range(len(sts)):
+    for k in range(jt.x.shape[0]):
         st = sts[k]
         copy_into(st.work.x, jt.x[k])
         weight = st.problem.model.mass.sum() * max(st.gravity, 1.0)
         changed |= implicit.lag_changed(st, st.start, st.work, weight)
     if changed:
-        for k in range(len(sts)):
+        for k in range(jt.x.shape[0]):
             copy_into(sts[k].start.lam, sts[k].work.lam)
             drums.accept_lag(sts[k].drums)
     return changed
@@ -245,11 +249,11 @@ def _finish(method, sts, jt):
     ``jt.x``."""
     jt.force[:] = 0.0
     jt.trial_blocks[:] = 0.0
-    for k in range(len(sts)):
+    for k in range(jt.x.shape[0]):
         st = sts[k]
         increment.contact_gradient(st, st.start, jt.x[k], jt.force[k], jt.trial_blocks[k], st.work.u3)
     gradient_pairs(jt, jt.x, jt.force, jt.trial_blocks)
-    for k in range(len(sts)):
+    for k in range(jt.x.shape[0]):
         st = sts[k]
         for i in range(jt.x.shape[1]):
             for c in range(3):
@@ -267,6 +271,14 @@ def gradient_pairs(jt, x, grad, blocks):
     )  # fmt: skip
 
 
+def padded(sts: tuple[R, ...]) -> tuple[R, ...]:
+    """``sts`` with its first record repeated up to ``SHARED_GROUP`` records. A tuple's length is
+    part of its numba type, so the step of one shell with self-contact and that of a pair compile
+    once between them; the kernels loop over the group's ``jt.x.shape[0]`` shells, never over the
+    tuple's padding."""
+    return sts + (sts[0],) * (SHARED_GROUP - len(sts))
+
+
 @kernel
 def step_kernel(method, sts, jt, x0, v0, a0, h):
     """One joint step of ``h`` (s) from ``(x0, v0, a0)`` (S, V, 3) into ``jt.x``, ``jt.force`` and
@@ -276,7 +288,7 @@ def step_kernel(method, sts, jt, x0, v0, a0, h):
     if not _start(method, sts, jt, x0, v0, a0, h):
         return 5, 0, 0
     frictional = False
-    for k in range(len(sts)):
+    for k in range(jt.x.shape[0]):
         for g in range(sts[k].mu.shape[0]):
             frictional |= sts[k].mu[g] > 0.0
         frictional |= drums.frictional(sts[k].drums)
@@ -290,7 +302,7 @@ def step_kernel(method, sts, jt, x0, v0, a0, h):
         if not frictional or lag == implicit.FRICTION_LAGS or not _lags_changed(sts, jt):
             break
     _finish(method, sts, jt)
-    for k in range(len(sts)):
+    for k in range(jt.x.shape[0]):
         sts[k].work.energy[0] = implicit.end_energy(sts[k], jt.x[k], sts[k].work.v1)
     cd = jt.candidates
     sts[0].work.energy[0] += contact.energy(
@@ -304,9 +316,11 @@ def step(
 ) -> list[implicit.StepResult]:
     """One joint step of ``h`` (s) from ``(x0, v0, a0)`` (S, V, 3) (module doc): each shell's
     result, the group's Newton and CG iterations and its pairs' barrier energy counted on its first
-    shell;
-    :class:`implicit.StepFailure` (:class:`PairsOverflow`) if none."""
-    status, iterations, cg_iterations = step_kernel(method, sts, jt, x0, v0, a0, h)
+    shell; :class:`implicit.StepFailure` (:class:`PairsOverflow`) if none. The records pass to the
+    compiled step by reference (``record_ref.reference``: a pointer each, where a NamedTuple passes
+    every array), the shells' tuple :func:`padded`."""
+    refs = padded(tuple(reference(st) for st in sts))
+    status, iterations, cg_iterations = step_kernel(method, refs, reference(jt), x0, v0, a0, h)
     if status == 5:
         raise PairsOverflow(FAILURES[5])
     if status != 0:
