@@ -25,7 +25,7 @@ from __future__ import annotations
 import argparse
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import gymnasium as gym
 import numpy as np
@@ -60,31 +60,44 @@ class Score3D:
     returns: tuple[float, ...]
 
 
-def run_episode(
-    env: gym.Env[Any, Any], policy: Policy, seed: int
-) -> tuple[list[float], list[float], int, float]:
-    """One episode: (each apex's relative height error, each apex's spot distance in m, missed
-    ones appended; its length in control steps; its return)."""
+class Apex(NamedTuple):
+    """One flight apex of an episode (the module doc's errors)."""
+
+    height: float  # |h - h_t| / h_t; 1 for a missed apex
+    distance: float  # m: the centre's horizontal distance to the target spot (0 in pressure mode)
+    step: int  # the control steps taken when it was seen (the episode's length for a missed apex)
+
+
+def apex_records(env: gym.Env[Any, Any], policy: Policy, seed: int) -> tuple[list[Apex], int, float]:
+    """One episode: (its apexes, missed ones appended; its length in control steps; its return)."""
     obs, _ = env.reset(seed=seed)
     policy.reset(seed)
     ball = ball3d_env(env)
     structure, config = ball.observation_structure, ball.config
     limit = env.spec.max_episode_steps if env.spec and env.spec.max_episode_steps else None
-    heights: list[float] = []
-    spots: list[float] = []
+    apexes: list[Apex] = []
     total, length = 0.0, 0
     while True:
         obs, reward, terminated, truncated, info = env.step(policy.act(obs))
         total, length = total + float(reward), length + 1
         distance = spot_distance(obs, structure) if config.paddle else 0.0
         if info["apex_count"]:
-            heights.append(abs(info["apex_height"] - info["target_height"]) / info["target_height"])
-            spots.append(distance)
+            height = abs(info["apex_height"] - info["target_height"]) / info["target_height"]
+            apexes.append(Apex(height, distance, length))
         if terminated and limit:
             missed = missed_apexes(config, info["target_height"], (limit - length) * config.control_dt)
-            heights, spots = heights + [1.0] * missed, spots + [distance] * missed
+            apexes += [Apex(1.0, distance, length)] * missed
         if terminated or truncated:
-            return heights, spots, length, total
+            return apexes, length, total
+
+
+def run_episode(
+    env: gym.Env[Any, Any], policy: Policy, seed: int
+) -> tuple[list[float], list[float], int, float]:
+    """One episode: (each apex's relative height error, each apex's spot distance in m, missed
+    ones appended; its length in control steps; its return)."""
+    apexes, length, total = apex_records(env, policy, seed)
+    return [a.height for a in apexes], [a.distance for a in apexes], length, total
 
 
 def spot_distance(obs: NDArray[np.float32], structure: dict[str, slice]) -> float:

@@ -1,5 +1,7 @@
 """agents.evaluate3d: the 3-D ball's height-and-spot errors per episode, reproducible, with missed
-apexes counted; and PPO and SAC runs of train.py on InflatedBall3DPaddle-v0 scored by it."""
+apexes counted; each apex's control step, and benchmarks/ball3d_headroom.py's split of an episode's
+apexes at the dribbler's first strike; and PPO and SAC runs of train.py on InflatedBall3DPaddle-v0
+scored by it."""
 
 import math
 
@@ -8,9 +10,10 @@ import numpy as np
 import pytest
 import yaml
 
-from agents.evaluate3d import evaluate3d, main, run_episode
-from agents.policies import IdlePolicy
+from agents.evaluate3d import apex_records, evaluate3d, main, run_episode
+from agents.policies import Heuristic3DPolicy, IdlePolicy
 from agents.train import parse_args, train
+from tests.benchmark_modules import load_benchmark
 
 SHORT = {"action_mode": "paddle", "max_episode_steps": 120}
 
@@ -42,6 +45,29 @@ def test_an_episode_that_ends_at_rest_counts_its_missed_apexes():
     assert ball.end == "rest" and missed >= 1
     assert heights[-missed:] == [1.0] * missed and max(heights[:-missed]) < 1.0
     assert len(set(spots[-missed:])) == 1
+
+
+def test_each_apex_has_its_control_step_and_the_headroom_split_cuts_at_the_first_strike():
+    """Episode 10,003 starts above its target: the dribbler idles through two apexes (about steps 85
+    and 166), strikes at step 167, and sets the third apex."""
+    env = gym.make("ballenv:InflatedBall3DPaddle-v0", max_episode_steps=250)
+    policy = Heuristic3DPolicy(env)
+    apexes, length, _ = apex_records(env, policy, 10_003)
+    heights, spots, _, _ = run_episode(env, policy, 10_003)
+    assert [a.height for a in apexes] == heights and [a.distance for a in apexes] == spots
+    steps = [a.step for a in apexes]
+    assert steps == sorted(set(steps)) and 0 < steps[0] and steps[-1] <= length == 250
+    bench = load_benchmark("ball3d_headroom")
+    rows = bench.split(10_003, 250)
+    assert [after for *_, after in rows] == [False, False, True]
+    assert [(h, d) for h, d, _ in rows] == list(zip(heights, spots, strict=True))
+    expected = np.mean(heights) / 0.5 + np.mean(spots) / 0.3
+    assert bench.combined(rows, 1.0) == pytest.approx(expected)
+    assert bench.combined(rows, 0.0) == pytest.approx(
+        np.sum(heights[:2]) / 3 / 0.5 + np.sum(spots[:2]) / 3 / 0.3
+    )
+    text = bench.verdict(0.2, 0.25, 0.19)
+    assert "ends at 0.250 (not below it)" in text and "at 0.190 (below it)" in text
 
 
 def test_the_pump_and_constant_gas_run_in_pressure_mode(capsys):
