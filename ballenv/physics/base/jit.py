@@ -17,7 +17,8 @@ function taking the records that is most of its compile time, and most kernels a
 by other kernels. So a kernel is compiled without them (numba's ``no_cpython_wrapper``,
 ``no_cfunc_wrapper``). Called from Python, a kernel calls its twin (:func:`python_entry`): the same
 function compiled with the wrappers, cached under its own name (``<name>.python``), compiled only
-for kernels Python calls (``simulate``'s driver, the env's step and reset, a test). Processes that
+for kernels Python calls (``simulate``'s driver, the env's step and reset, a test), and given its
+records by reference (:func:`by_reference`). Processes that
 compile the same twin for the same argument types at once compile it once (:mod:`.compile_lock`).
 Only the twins are turned into machine code; the kernels they call stay LLVM IR, linked into each
 twin (:mod:`.machine_code`).
@@ -28,7 +29,7 @@ import types
 from numba import njit
 from numba.core.registry import CPUDispatcher
 
-from . import cache_location, machine_code
+from . import cache_location, machine_code, record_ref
 from .compile_lock import SharedCompile
 
 OPTIONS = {"cache": cache_location.apply(), "_nrt": False}  # no cache only where nothing is writable
@@ -38,10 +39,30 @@ machine_code.install()
 
 class InnerKernel(CPUDispatcher):
     """A kernel compiled without Python wrappers; called from Python, it calls its twin
-    (:func:`python_entry`)."""
+    (:func:`python_entry`) with its records by reference (:func:`by_reference`)."""
 
     def __call__(self, *args, **kwargs):
+        args = tuple(by_reference(a) for a in args)
+        kwargs = {k: by_reference(v) for k, v in kwargs.items()}
         return python_entry(self)(*args, **kwargs)
+
+
+def by_reference(value):
+    """``value`` as a kernel called from Python takes it: a record (a NamedTuple of arrays,
+    scalars, None and records) as its :class:`.record_ref.RecordRef`, a tuple of records as a tuple
+    of theirs, anything else as it is. The twin then unboxes one pointer a record, not its every
+    array, and compiles for the same types as the kernels that the step passes records by reference
+    (one compile of a kernel both call, not one for each)."""
+    if not isinstance(value, tuple):
+        return value
+    if hasattr(value, "_fields"):
+        try:
+            return record_ref.reference(value)
+        except TypeError:  # a field with no layout in a RecordRef: passed by value
+            return value
+    if value and all(hasattr(v, "_fields") for v in value):
+        return tuple(by_reference(v) for v in value)
+    return value
 
 
 def python_entry(dispatcher):
