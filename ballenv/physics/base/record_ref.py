@@ -10,8 +10,9 @@ pointer, shape, strides; a scalar's value; a nested record's buffer address; not
 Compiled code gets the buffer's address and reads a field where it is used, so a kernel's field
 reads (``model.ei``, ``ws.barrier is None``) compile as for the NamedTuple, to the same values.
 
-The kernels compile without reference counting (``jit.py``), so the descriptors carry no meminfo:
-the RecordRef keeps every array alive, and the caller keeps the RecordRef alive for the call. The
+The kernels compile without reference counting (``jit.py``), so the descriptors carry no meminfo
+(and as parent the array's own Python object, which such a kernel returns for the array, as for the
+NamedTuple): the RecordRef keeps every array alive, and the caller keeps the RecordRef alive for the call. The
 buffer is read-only to compiled code (loads marked invariant); a record whose arrays are replaced
 needs a new RecordRef (:func:`reference` makes one per record object).
 """
@@ -99,7 +100,9 @@ def _words(value: Any) -> list[int]:
     if isinstance(value, np.ndarray):
         shape = [int(s) for s in value.shape]
         strides = [int(s) % 2**64 for s in value.strides]
-        return [0, 0, value.size, value.itemsize, value.ctypes.data, *shape, *strides]
+        # no meminfo; the parent is the array's own Python object, what a kernel compiled without
+        # reference counting returns for an array (numba's box_array), as for the NamedTuple
+        return [0, id(value), value.size, value.itemsize, value.ctypes.data, *shape, *strides]
     if isinstance(value, RecordRef):
         return [value.address]
     if value is None:

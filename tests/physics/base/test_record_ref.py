@@ -85,6 +85,19 @@ def test_a_record_ref_passes_one_pointer_where_a_named_tuple_passes_every_array(
     assert RecordRef(record).buffer.size * record_ref.WORD == ref_type.offsets["inner"] + record_ref.WORD
 
 
+@njit(_nrt=False)
+def _fields(r):
+    return r.x, r.inner.counts
+
+
+def test_a_kernel_returns_field_arrays_of_a_record_ref_as_the_arrays_themselves():
+    """numba without reference counting returns an array's parent: the Python array it came from."""
+    outer = _outer()
+    for record in (outer, RecordRef(outer)):
+        x, counts = _fields(record)
+        assert x is outer.x and counts is outer.inner.counts
+
+
 def test_a_pickled_record_ref_points_at_its_own_copies_of_the_arrays():
     record = _outer()
     copy = pickle.loads(pickle.dumps(RecordRef(record)))
