@@ -114,9 +114,12 @@ def oracle(seed: int, strikes: int, steps: int) -> list[tuple[float, float]]:
 def combined(rows: list[tuple[float, float, bool]], factor: float) -> float:
     """An episode's combined error (``agents.evaluate3d``) with the errors of the apexes after the
     first strike times ``factor``."""
+    from agents.evaluate3d import combined_error
+    from ballenv.envs.ball3d.config import Ball3DConfig
+
     height = np.mean([h * (factor if after else 1.0) for h, _, after in rows])
     distance = np.mean([d * (factor if after else 1.0) for _, d, after in rows])
-    return float(height / 0.5 + distance / 0.3)
+    return combined_error(Ball3DConfig(action_mode="paddle"), float(height), float(distance))
 
 
 def interval(scores: NDArray[np.float64], runs: int) -> str:
