@@ -12,9 +12,9 @@ reads (``model.ei``, ``ws.barrier is None``) compile as for the NamedTuple, to t
 
 The kernels compile without reference counting (``jit.py``), so the descriptors carry no meminfo
 (and as parent the array's own Python object, which such a kernel returns for the array, as for the
-NamedTuple): the RecordRef keeps every array alive, and the caller keeps the RecordRef alive for the call. The
-buffer is read-only to compiled code (loads marked invariant); a record whose arrays are replaced
-needs a new RecordRef (:func:`reference` makes one per record object).
+NamedTuple): the RecordRef keeps every array alive, and the caller keeps the RecordRef alive for
+the call. The buffer is read-only to compiled code (loads marked invariant); a record whose arrays
+are replaced needs a new RecordRef (:func:`reference` makes one per record object).
 """
 
 import threading

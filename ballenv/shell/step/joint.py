@@ -23,7 +23,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ...physics.base.jit import copy_into, kernel
-from ...physics.base.record_ref import reference
 from ..rest.equilibrium import ARMIJO, HALVINGS
 from ..solve import jointcg, stepsolve
 from ..touch import broadphase, contact, drums, ground
@@ -317,10 +316,9 @@ def step(
     """One joint step of ``h`` (s) from ``(x0, v0, a0)`` (S, V, 3) (module doc): each shell's
     result, the group's Newton and CG iterations and its pairs' barrier energy counted on its first
     shell; :class:`implicit.StepFailure` (:class:`PairsOverflow`) if none. The records pass to the
-    compiled step by reference (``record_ref.reference``: a pointer each, where a NamedTuple passes
+    compiled step by reference (``jit.by_reference``: a pointer each, where a NamedTuple passes
     every array), the shells' tuple :func:`padded`."""
-    refs = padded(tuple(reference(st) for st in sts))
-    status, iterations, cg_iterations = step_kernel(method, refs, reference(jt), x0, v0, a0, h)
+    status, iterations, cg_iterations = step_kernel(method, padded(sts), jt, x0, v0, a0, h)
     if status == 5:
         raise PairsOverflow(FAILURES[5])
     if status != 0:
