@@ -4,17 +4,19 @@ env's first steps (make, reset and three steps of ``InflatedBall-v3``), for the 
 (``InflatedBall3DPaddle-v0``) and for the first ``simulate()`` of one ring on a floor (``Scene``'s
 defaults, 20 ms).
 
-Each scenario runs twice in the same minute: as the package compiles (machine code only for the
-entry points Python calls, ``ballenv/physics/base/machine_code.py``) and with numba's own code
-library put back (every compiled function optimised and emitted on its own, as numba does by
-default), so the page shows what the lazy machine code saves as a ratio on the same machine. The
-libraries turned into machine code are counted; the LLVM time is every library's module optimisation
-plus that machine code.
+Each scenario runs twice in the same minute: as the package compiles (module optimisation and
+machine code only for the entry points Python calls, each with its whole call tree linked in,
+``ballenv/physics/base/machine_code.py``) and with numba's own code library put back (every compiled
+function's module optimised and emitted on its own, as numba does by default), so the page shows
+what the lazy library saves as a ratio on the same machine. The libraries turned into machine code
+are counted; the LLVM time is the module optimisation of the libraries optimised plus that machine
+code.
 
 A pass's time is its own (s): a callee compiled while its caller is typed is counted to the
 callee. Per function: typing (numba's type inference passes), lowering (``native_lowering``: the
-LLVM IR and its optimisation, which includes every callee inlined into it) and the rest of numba's
-passes. The table lists the functions that take the most, and the sums over all of them.
+LLVM IR, its per-function optimisation and, where the library's module is optimised, that
+optimisation, which includes every callee inlined into it) and the rest of numba's passes. The
+table lists the functions that take the most, and the sums over all of them.
 
     python benchmarks/compile_profile.py   # writes benchmarks/results/compile_profile.md
 """
@@ -184,7 +186,8 @@ def main():
         f"{min(loads):.1f}-{max(loads):.1f}: above {os.cpu_count()}, other processes shared the cores), "
         "an empty `NUMBA_CACHE_DIR` per scenario. Own time of numba's passes per function "
         "(a callee compiled while its caller is typed counts to the callee); lowering includes LLVM's "
-        "optimisation and machine code of the function's library, with everything linked into it. "
+        "per-function optimisation and, for a library whose module is optimised (in the lazy run an "
+        "entry point's only), that module optimisation and machine code, with everything linked into it. "
         "The machine's speed varies from day to "
         "day: compare the shares, not the seconds of different days.\n\n" + "\n\n".join(sections) + "\n"
     )

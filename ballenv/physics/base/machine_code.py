@@ -1,22 +1,26 @@
-"""Machine code only where Python calls: a compiled function that only other compiled code calls
-keeps its optimised LLVM IR and is never turned into machine code on its own.
+"""Machine code only where Python calls, and one optimisation of each call tree: a compiled
+function that only other compiled code calls keeps its LLVM IR, unoptimised as a module, and is
+never turned into machine code on its own.
 
 numba compiles every function into a code library and, as soon as it is compiled, optimises the
 library's module (the function with every callee linked into it) and emits its machine code, so that
 a pointer to it exists. A caller then links the callee's optimised IR into its own library and does
-the same again: a callee at depth d of the call tree is emitted d + 1 times. The simulator's kernels
-are a deep tree that only a few entry points (:func:`.jit.python_entry`) are called through, so most
-of that machine code is thrown away (``benchmarks/results/compile_profile.md`` counts it).
+the same again: a callee at depth d of the call tree is optimised and emitted d + 1 times. The
+simulator's kernels are a deep tree that only a few entry points (:func:`.jit.python_entry`) are
+called through, so most of that work is thrown away (``benchmarks/results/compile_profile.md``).
 
-:class:`LazyLibrary` (installed as the CPU codegen's library class by :func:`install`) optimises a
-library's module as numba does (callees reach their callers optimised, so the entry points inline
-as before and their code is numba's own) but postpones its machine code until a pointer to one of
-its functions is asked for. A kernel compiled without Python wrappers (:func:`.jit.kernel`) is asked
-only for the wrapper it does not have, so it stays IR; an entry point is asked for its wrapper, and
-its library, with every callee linked in, is emitted once. An inner kernel's cache entry holds its
-optimised IR (numba's "bitcode" kind) instead of machine code; a caller compiled in a later process
-links that IR. The environment pointer numba stores in a library's module (exceptions, boxing) is
-stored when that module reaches the engine (:func:`_set_env`).
+:class:`LazyLibrary` (installed as the CPU codegen's library class by :func:`install`) postpones a
+library's module optimisation and its machine code until a pointer to one of its functions is asked
+for. A kernel compiled without Python wrappers (:func:`.jit.kernel`) is asked only for the wrapper
+it does not have, so it stays IR, optimised function by function as numba does when it adds a module
+(no inlining across functions yet); an entry point is asked for its wrapper, and its library, with
+every callee linked in, is optimised by numba's module passes once, the whole call tree together
+(LLVM's inliner works bottom-up through it), then emitted. Outside the few fast-math kernels LLVM
+keeps IEEE arithmetic wherever it inlines, and the fingerprint (``benchmarks/fingerprint.py``) is
+the one numba's own library gives. An inner kernel's cache entry holds its IR (numba's "bitcode"
+kind) instead of machine code; a caller compiled in a later process links that IR. The environment
+pointer numba stores in a library's module (exceptions, boxing) is stored when that module reaches
+the engine (:func:`_set_env`).
 """
 
 import llvmlite.binding as ll  # type: ignore[import-untyped]
@@ -27,14 +31,15 @@ _waiting_envs: dict[str, object] = {}
 
 
 class LazyLibrary(codegen.JITCodeLibrary):
-    """numba's JIT code library whose machine code waits for the first
+    """numba's JIT code library whose module optimisation and machine code wait for the first
     :meth:`get_pointer_to_function` of a function it defines (see the module doc)."""
 
-    _deferred = False
+    _deferred = False  # machine code not emitted yet
+    _unoptimised = False  # module passes not run yet
 
     def _optimize_final_module(self):
-        super()._optimize_final_module()
-        self._deferred = True  # a library being finalised: its machine code waits
+        # a library being finalised: its module passes and machine code wait for a pointer
+        self._deferred = self._unoptimised = True
 
     def _finalize_final_module(self):
         if not self._deferred:  # one loaded with its machine code from the cache
@@ -44,14 +49,18 @@ class LazyLibrary(codegen.JITCodeLibrary):
         self._finalized = True
 
     def _emit(self):
-        """numba's final module steps: into the engine, machine code; then the waiting envs."""
+        """numba's final module steps: the module passes (if they wait), into the engine, machine
+        code; then the waiting envs."""
+        if self._unoptimised:
+            self._unoptimised = False
+            super()._optimize_final_module()
         super()._finalize_final_module()
         for name in list(_waiting_envs):
             if self._codegen._engine.get_global_value_address(name):
                 _numba_set_env(self._codegen, name, _waiting_envs.pop(name))
 
     def _undefer(self):
-        """Emit the optimised module's machine code, as numba's ``finalize`` would have."""
+        """Optimise the module and emit its machine code, as numba's ``finalize`` would have."""
         if self._deferred:
             self._deferred = False
             self._emit()
@@ -76,7 +85,7 @@ class LazyLibrary(codegen.JITCodeLibrary):
             return super()._unserialize(codegen_, state)
         self = codegen_.create_library(name)
         self._final_module = ll.parse_bitcode(data)
-        self._deferred = True
+        self._deferred = self._unoptimised = True
         self._finalized = True
         return self
 

@@ -1,6 +1,6 @@
 """Machine code only where Python calls (``ballenv.physics.base.machine_code``): a kernel that only
-compiled code calls stays LLVM IR, linked into the entry points that call it; its cache entry is
-IR that a later caller links."""
+compiled code calls stays LLVM IR, unoptimised as a module, linked into the entry points that call
+it, whose modules are optimised once with it; its cache entry is IR that a later caller links."""
 
 import os
 import subprocess
@@ -29,10 +29,39 @@ def test_an_inner_kernel_stays_ir_and_its_caller_is_emitted_once_with_it_linked_
     assert polygon_area(SQUARE) == 1.0  # Python calls the twin, which calls next_node
     next_node.compile((types.int64, types.int64))  # compiled here, or loaded from the cache as IR
     (callee,) = _libraries(next_node)
-    assert callee._deferred  # optimised IR, no machine code of its own
+    assert callee._deferred and callee._unoptimised  # IR, no module passes, no machine code
     assert callee.get_pointer_to_function("no such wrapper") == 0 and callee._deferred
     (entry,) = _libraries(jit.python_entry(polygon_area))
-    assert not entry._deferred  # optimised and emitted, with next_node linked in
+    assert not entry._deferred and not entry._unoptimised  # optimised and emitted, next_node in it
+
+
+PASSES = """
+from numba.core import codegen
+import ballenv.physics.base.jit  # noqa: F401  (installs the lazy library)
+
+optimised = []
+module_passes = codegen.CPUCodeLibrary._optimize_final_module
+
+
+def counted(library):
+    optimised.append(library.name)
+    module_passes(library)
+
+
+codegen.CPUCodeLibrary._optimize_final_module = counted
+import numpy as np
+from ballenv.physics.base.geometry import polygon_area
+print(polygon_area(np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [0.0, 1.0]])))
+print(len(optimised), optimised[0].split(".")[-1])
+"""
+
+
+def test_the_module_passes_run_once_for_an_entry_point_and_its_callees(tmp_path):
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path), OPENBLAS_NUM_THREADS="1")
+    run = subprocess.run([sys.executable, "-c", PASSES], env=env, capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr[-2000:]
+    # numba's own library runs them for next_node and again for the entry with next_node linked in
+    assert run.stdout.split() == ["2.0", "1", "python"]
 
 
 CALLER = """
