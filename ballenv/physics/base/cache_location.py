@@ -62,9 +62,18 @@ class PackageLocator(_UserLocator):
     hash of the file in numba 0.68; its time and size in older releases, which a new checkout
     changes (there a new checkout compiles)."""
 
+    _ensured: set[str] = set()  # the folders checked so far in this process
+
     def __init__(self, py_func, py_file):
         super().__init__(py_func, py_file)
         self._cache_path = os.path.join(config.CACHE_DIR, *within_package(py_file).parent.parts)
+
+    def ensure_cache_path(self):
+        """numba's check that the kernel's folder exists (made) and takes a new file, once a folder
+        per process (numba makes a temporary file for every kernel it loads)."""
+        if self._cache_path not in self._ensured:
+            super().ensure_cache_path()
+            self._ensured.add(self._cache_path)
 
     @classmethod
     def from_function(cls, py_func, py_file):

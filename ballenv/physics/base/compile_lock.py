@@ -24,6 +24,7 @@ own and says so. Where no private lock folder can be had (a read-only home, a fo
 kernel compiles without a lock, as numba does.
 """
 
+import functools
 import hashlib
 import os
 import pathlib
@@ -42,6 +43,7 @@ WAITING = "waiting for another process compiling the simulator (%s); it then loa
 GAVE_UP = "waited %.0f s for another process compiling the simulator (%s); compiling it here instead"
 
 
+@functools.cache  # asked for every kernel of a file, each a resolve of its path
 def within_package(path):
     """Source file ``path`` relative to the package's folder, or None if it lies outside it."""
     path = pathlib.Path(path).resolve()
