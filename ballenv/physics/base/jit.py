@@ -29,13 +29,14 @@ import types
 from numba import njit
 from numba.core.registry import CPUDispatcher
 
-from . import cache_location, call_types, machine_code, record_ref
+from . import cache_location, call_types, error_text, machine_code, record_ref
 from .compile_lock import SharedCompile
 
 OPTIONS = {"cache": cache_location.apply(), "_nrt": False}  # no cache only where nothing is writable
 WRAPPERS = ("no_cpython_wrapper", "no_cfunc_wrapper")
 machine_code.install()
 call_types.install()
+error_text.install()
 
 
 class InnerKernel(CPUDispatcher):
