@@ -4,8 +4,9 @@ given argument types, memoised.
 numba types a call of an operator or builtin (``a[i, c]``, ``x * y``, ``max``) by trying its typing
 templates in order until one accepts the argument types, and types it again when it lowers it.
 Each template that declines builds an error report, and an array read tries seven (strings, typed
-lists and dicts, ...) before the array's own: the env's first compile resolves about 12,000 calls
-of 300 distinct (function, argument types) pairs, and that search took 9.7 of its 34 s.
+lists and dicts, ...) before the array's own. A kernel's many array reads and products resolve the
+same few hundred (function, argument types) pairs again and again; that search was the largest part
+of numba's typing (``benchmarks/results/compile_profile.md``).
 
 :func:`install` wraps ``BaseFunction.get_call_type`` (the method of numba's function types that
 does the search) with a memo keyed on the function type (its typing key and templates: a function
