@@ -68,7 +68,8 @@ def env_facts():
 
 
 def make_test_time(hooks):
-    return results_cell(hooks, "make_test.md", ("total",), "wall")
+    heading = "Commit 3fcf8e7, an empty cache"  # the newest measurement the pages quote
+    return results_cell(hooks, "make_test.md", ("pytest",), "wall", heading=heading)
 
 
 def cold_env(hooks):
@@ -102,10 +103,10 @@ FACTS = {
         r"at most (\d+) steps \((\d+) s\)",
         lambda hooks: [env_facts()["episode steps"], env_facts()["episode seconds"]],
     ),
-    "make test's time": ("README.md", r"`make test` took (\d+ min \d+ s)", make_test_time),
+    "make test's time": ("README.md", r"`make test`'s pytest took (\d+ min \d+ s)", make_test_time),
     "make test's time, quick start": (
         "docs/quickstart.md",
-        r"`make test` took (\d+ min \d+ s)",
+        r"`make test`'s pytest took (\d+ min \d+ s)",
         make_test_time,
     ),
     "cold start": ("README.md", r"empty compile cache .*?\| ([\d.]+) s \|", cold_env),

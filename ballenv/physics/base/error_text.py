@@ -3,10 +3,9 @@
 numba marks up the text of every error it makes, and most are made and caught while it compiles: a
 typing template that declines, a value with no literal type, an implementation looked up in the
 wrong registry. Each markup starts and stops colorama's stream wrapper, tens of thousands of times
-in a first compile. With numba's default colour scheme (``"no_color"``) the
-markup is only the bold weight, so :func:`install` makes numba's one colour scheme return the text
-as it is. A scheme chosen with ``NUMBA_COLOR_SCHEME`` is left alone, and without colorama numba
-marks nothing up anyway.
+in a first compile. With numba's default colour scheme (``"no_color"``) the markup is only the bold
+weight, so :func:`install` makes numba's one colour scheme return the text as it is. A scheme chosen
+with ``NUMBA_COLOR_SCHEME`` is left alone, and without colorama numba marks nothing up anyway.
 """
 
 from numba.core import config, errors

@@ -21,7 +21,9 @@ for kernels Python calls (``simulate``'s driver, the env's step and reset, a tes
 records by reference (:func:`by_reference`). Processes that
 compile the same twin for the same argument types at once compile it once (:mod:`.compile_lock`).
 Only the twins are turned into machine code; the kernels they call stay LLVM IR, linked into each
-twin (:mod:`.machine_code`).
+twin and optimised there once (:mod:`.machine_code`). Two repetitions in numba's own compiler are
+done once: the search for a call's signature (:mod:`.call_types`) and the terminal markup of the
+errors it makes and catches (:mod:`.error_text`).
 """
 
 import types
