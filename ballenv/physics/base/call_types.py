@@ -22,13 +22,15 @@ import copy
 
 from numba.core.types import functions
 
-_memo: dict[tuple, object] = {}  # (context id, function key, args, kws) -> signature
+_memo: dict[tuple, object] = {}  # (context, function key, args, kws) -> signature
 
 
 def _resolve(self, context, args, kws):
     """``BaseFunction.get_call_type``, memoised (module doc)."""
     try:
-        key = (id(context), self.key, tuple(args), tuple(sorted(kws.items())))
+        # the context itself (hashed by identity and kept alive), not its id: an id of a
+        # context collected could come back for a new one
+        key = (context, self.key, tuple(args), tuple(sorted(kws.items())))
         hash(key)
     except TypeError:  # an argument type that cannot be hashed: resolved as numba does
         return _numba_get_call_type(self, context, args, kws)
