@@ -10,7 +10,7 @@ shows it the cheapest for a given first-apex error) with adaptive steps at most 
 =========  ========  ======  =====  ==========  ===========  ===========================
 preset     vertices  k       rtol   largest dt  newton_tol   first-apex error (bound)
 =========  ========  ======  =====  ==========  ===========  ===========================
-fast       162       2       1e-3   0.01 s      1e-4         1.5 %
+fast       162       2       1e-3   0.01 s      1e-4         2.5 %
 balanced   642       3       3e-4   0.004 s     1e-6         0.75 %
 accurate   2562      4       1e-4   0.002 s     1e-7         0.5 %
 =========  ========  ======  =====  ==========  ===========  ===========================
@@ -18,8 +18,11 @@ accurate   2562      4       1e-4   0.002 s     1e-7         0.5 %
 The bound is on the error of the step control: the first apex of each ball of
 ``benchmarks/shell_presets.py`` against a converged run of the same ball on the same mesh
 (``tests/shell/test_presets.py`` checks it; ``benchmarks/results/shell_presets.md`` has the
-errors and wall times). The mesh is a separate choice with its own error, which the same page
-gives for every ball against the finest mesh.
+errors and wall times), the worst of each run and of runs with ``rtol`` a few per cent off. The
+fast preset's loose Newton tolerance leaves the small stiff ball's first apex 0.7 to 1.8 % low
+depending on the CPU's rounding and such small changes of ``rtol`` (one Newton iteration more or
+less in a contact step); its bound covers that spread. The mesh is a separate choice with its own
+error, which the same page gives for every ball against the finest mesh.
 """
 
 import dataclasses
@@ -31,7 +34,7 @@ from .scene import Scene
 PRESET_RHO_INFINITY = 0.0
 
 FIDELITY_PRESETS: dict[str, dict[str, Any]] = {
-    "fast": {"subdivisions": 2, "rtol": 1e-3, "dt": 1e-2, "newton_tol": 1e-4, "apex_error_bound": 0.015},
+    "fast": {"subdivisions": 2, "rtol": 1e-3, "dt": 1e-2, "newton_tol": 1e-4, "apex_error_bound": 0.025},
     "balanced": {"subdivisions": 3, "rtol": 3e-4, "dt": 4e-3, "newton_tol": 1e-6, "apex_error_bound": 0.0075},
     "accurate": {"subdivisions": 4, "rtol": 1e-4, "dt": 2e-3, "newton_tol": 1e-7, "apex_error_bound": 0.005},
 }
