@@ -21,9 +21,10 @@ for kernels Python calls (``simulate``'s driver, the env's step and reset, a tes
 records by reference (:func:`by_reference`). Processes that
 compile the same twin for the same argument types at once compile it once (:mod:`.compile_lock`).
 Only the twins are turned into machine code; the kernels they call stay LLVM IR, linked into each
-twin and optimised there once (:mod:`.machine_code`). Two repetitions in numba's own compiler are
-done once: the search for a call's signature (:mod:`.call_types`) and the terminal markup of the
-errors it makes and catches (:mod:`.error_text`).
+twin and optimised there once (:mod:`.machine_code`). Repetitions in numba's own compiler are
+done once or not at all: the search for a call's signature (:mod:`.call_types`), the terminal
+markup of the errors it makes and catches (:mod:`.error_text`) and the two copies of the IR it
+inlines at each call of an ``inline="always"`` kernel (:mod:`.fresh_inline`).
 """
 
 import types
@@ -31,7 +32,7 @@ import types
 from numba import njit
 from numba.core.registry import CPUDispatcher
 
-from . import cache_location, call_types, error_text, machine_code, record_ref
+from . import cache_location, call_types, error_text, fresh_inline, machine_code, record_ref
 from .compile_lock import SharedCompile
 
 OPTIONS = {"cache": cache_location.apply(), "_nrt": False}  # no cache only where nothing is writable
@@ -39,6 +40,7 @@ WRAPPERS = ("no_cpython_wrapper", "no_cfunc_wrapper")
 machine_code.install()
 call_types.install()
 error_text.install()
+fresh_inline.install()
 
 
 class InnerKernel(CPUDispatcher):
