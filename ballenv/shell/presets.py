@@ -18,10 +18,10 @@ accurate   2562      4       1e-4   0.002 s     1e-7         0.5 %
 The bound is on the error of the step control: the first apex of each ball of
 ``benchmarks/shell_presets.py`` against a converged run of the same ball on the same mesh
 (``tests/shell/test_presets.py`` checks it; ``benchmarks/results/shell_presets.md`` has the
-errors and wall times), the worst of each run and of runs with ``rtol`` a few per cent off. The
-fast preset's loose Newton tolerance leaves the small stiff ball's first apex 0.7 to 1.8 % low
-depending on the CPU's rounding and such small changes of ``rtol`` (one Newton iteration more or
-less in a contact step); its bound covers that spread. The mesh is a separate choice with its own
+errors and wall times), the worst of each run and of runs with ``rtol`` a few per cent off. A
+loosely converged run (the fast preset's Newton tolerance) moves with such a change as with the
+rounding of another CPU (one Newton iteration more or less in a contact step), and its bound
+covers that spread. The mesh is a separate choice with its own
 error, which the same page gives for every ball against the finest mesh.
 """
 

@@ -7,9 +7,7 @@ that IR to ``InlineWorker.inline_ir``, which deep-copies every block of it twice
 relabels, renames and splices the blocks it inlines in place (the IR it is given may be shared, as an
 overload's IR kept for every call site is), and once more for an untouched copy it returns, which
 every caller in numba discards. The IR ``inline_function`` made is used by that call site alone, so
-copying it protects nothing; the simulator's kernels inline about 130 such calls in the env's first
-compile, and the copies were about a tenth of numba's time in it
-(``benchmarks/results/compile_profile.md``).
+copying it protects nothing.
 
 :func:`install` wraps ``inline_function``: while ``inline_ir`` runs, the new IR's blocks are their
 own deep copy (:class:`_OwnCopy`), and after it they are numba's ``ir.Block`` again, so any later

@@ -68,7 +68,7 @@ def test_numba_inlines_through_the_copy_free_inlining():
     assert InlineWorker.inline_function is fresh_inline._inline_function
 
 
-def test_a_later_deep_copy_of_inlined_blocks_is_a_copy():
+def test_only_a_block_marked_as_its_own_copy_skips_the_deep_copy():
     block = ir.Block(ir.Scope(None, ir.unknown_loc), ir.unknown_loc)
     block.__class__ = fresh_inline._OwnCopy
     assert copy.deepcopy(block) is block
