@@ -146,7 +146,7 @@ def main():
         "| phase | wall (s) |",
         "|---|---:|",
         *(f"| {name} | {seconds:.2f} |" for name, seconds in zip(PHASES, split, strict=True)),
-        f"| total | {sum(split):.2f} |",
+        f"| sum of the phases' best | {sum(split):.2f} |",
         "",
     ]
     text = "\n".join(lines)
