@@ -21,8 +21,16 @@ TINY = {
 }
 
 
-@pytest.mark.parametrize("mode", ["pressure", "paddle"])
-@pytest.mark.parametrize("algo", ["ppo", "sac"])
+# each algorithm and each mode once in the default run, the other two pairings in make test-slow
+@pytest.mark.parametrize(
+    ("algo", "mode"),
+    [
+        ("ppo", "pressure"),
+        ("sac", "paddle"),
+        pytest.param("ppo", "paddle", marks=pytest.mark.slow),
+        pytest.param("sac", "pressure", marks=pytest.mark.slow),
+    ],
+)
 def test_train_runs_end_to_end_and_the_saved_agent_reloads(algo, mode, tmp_path):
     command = [
         sys.executable, str(ROOT / "train.py"), "--algo", algo, "--action-mode", mode, "--seed", "3",

@@ -287,9 +287,15 @@ def test_the_residual_is_for_the_pressure_mode_only():
         ResidualPump(gym.make("InflatedBall-v3", action_mode="paddle"))
 
 
+# an observation wrapper and an action wrapper in the default run; ResidualPump, an action wrapper
+# on the same path as PumpAmplitude, in make test-slow
 @pytest.mark.parametrize(
     "wrapper",
-    ["agents.wrappers.BallStateObservation", "agents.wrappers.ResidualPump", "agents.wrappers.PumpAmplitude"],
+    [
+        "agents.wrappers.BallStateObservation",
+        pytest.param("agents.wrappers.ResidualPump", marks=pytest.mark.slow),
+        "agents.wrappers.PumpAmplitude",
+    ],
 )
 def test_a_run_trained_behind_the_wrapper_is_evaluated_behind_it(tmp_path, wrapper):
     hp = {"n_steps": 64, "batch_size": 64, "n_epochs": 1, "env_wrapper": wrapper}

@@ -12,6 +12,7 @@ elements' 81 + 144 entries per triangle and hinge: a fifth of the element-by-ele
 from typing import NamedTuple
 
 import numpy as np
+from numba import uint64
 from numpy.typing import NDArray
 
 from ...physics.base.jit import kernel
@@ -48,15 +49,19 @@ def block_pattern(n_vertices: int, triangles: NDArray[np.int64], hinges: NDArray
 
 @kernel
 def _scatter(slots, mats, scale, values):
-    """Adds ``scale`` times each element's matrix (rows ``3 m + c`` for its vertex m) to ``values``."""
-    n = slots.shape[1]
-    for e in range(slots.shape[0]):
+    """Adds ``scale`` times each element's matrix (rows ``3 m + c`` for its vertex m) to ``values``,
+    read and written as flat arrays at unsigned offsets (:func:`multiply`)."""
+    n = uint64(slots.shape[1])
+    row = uint64(3) * n  # an element matrix's row length
+    flat, elements = values.reshape(values.size), mats.reshape(mats.size)
+    for e in range(uint64(slots.shape[0])):
         for a in range(n):
             for b in range(n):
-                k = slots[e, a, b]
-                for c in range(3):
-                    for d in range(3):
-                        values[k, c, d] += scale * mats[e, 3 * a + c, 3 * b + d]
+                k = uint64(9) * uint64(slots[e, a, b])
+                start = (e * row + uint64(3) * a) * row + uint64(3) * b
+                for c in range(uint64(3)):
+                    for d in range(uint64(3)):
+                        flat[k + uint64(3) * c + d] += scale * elements[start + c * row + d]
 
 
 @kernel
@@ -87,13 +92,17 @@ def assemble_kept(pattern, tri_mats, hinge_values, scale, values):
 
 @kernel(fastmath=True)
 def multiply(pattern, values, x, y):
-    """``y = A x`` (V, 3)."""
+    """``y = A x`` (V, 3). The blocks and ``x`` (both C-contiguous) are read as flat arrays at
+    unsigned offsets: numba tests every signed index for a negative value (Python's ``a[-1]``) and
+    corrects it, an unsigned one not; the sums are the same, term for term."""
+    flat, xf = values.reshape(values.size), x.reshape(x.size)
+    one, two, three, nine = uint64(1), uint64(2), uint64(3), uint64(9)
     for v in range(x.shape[0]):
         y0 = y1 = y2 = 0.0
-        for k in range(pattern.row_start[v], pattern.row_start[v + 1]):
-            w = pattern.cols[k]
-            x0, x1, x2 = x[w, 0], x[w, 1], x[w, 2]
-            y0 += values[k, 0, 0] * x0 + values[k, 0, 1] * x1 + values[k, 0, 2] * x2
-            y1 += values[k, 1, 0] * x0 + values[k, 1, 1] * x1 + values[k, 1, 2] * x2
-            y2 += values[k, 2, 0] * x0 + values[k, 2, 1] * x1 + values[k, 2, 2] * x2
+        for k in range(uint64(pattern.row_start[v]), uint64(pattern.row_start[v + 1])):
+            w, b = three * uint64(pattern.cols[k]), nine * k
+            x0, x1, x2 = xf[w], xf[w + one], xf[w + two]
+            y0 += flat[b] * x0 + flat[b + one] * x1 + flat[b + two] * x2
+            y1 += flat[b + three] * x0 + flat[b + uint64(4)] * x1 + flat[b + uint64(5)] * x2
+            y2 += flat[b + uint64(6)] * x0 + flat[b + uint64(7)] * x1 + flat[b + uint64(8)] * x2
         y[v, 0], y[v, 1], y[v, 2] = y0, y1, y2
