@@ -1,7 +1,8 @@
 """Throughput of the 3-D ball's envs (InflatedBall3D-v0, InflatedBall3DPaddle-v0): env steps per
 second on one core with random actions at the "fast" preset (162 vertices), against InflatedBall-v3
 (the ring) measured in the same minute, with where the time goes; and the native vector env's
-scaling from one thread to two, and what looser step control would buy.
+scaling from one thread to two, what looser step control would buy and what each part of the
+implicit step costs.
 
     python benchmarks/env3d_throughput.py [--steps N]   # writes benchmarks/results/env3d_throughput.md
 
@@ -9,7 +10,9 @@ Single process, numba warm (a warm-up of 50 steps), OPENBLAS_NUM_THREADS=1. Step
 including resets, best of 3 repeats of ``--steps`` steps (seeded actions). "Simulator steps" are the
 accepted implicit steps per env step, "kernel share" the fraction of the time spent in the compiled
 implicit step. The machine's speed varies from day to day: the ratio to the ring's env, measured
-alternately with it, is the figure to compare across runs.
+alternately with it, is the figure to compare across runs. The sweep's work per env step (steps
+tried, Newton and CG iterations) does not depend on the machine; the parts' prices are best of 5
+repeats of 300 calls in one compiled loop, on the paddle env's state after 60 steps.
 """
 
 import os
@@ -20,13 +23,16 @@ import argparse  # noqa: E402
 import dataclasses  # noqa: E402
 import pathlib  # noqa: E402
 import time  # noqa: E402
+from typing import NamedTuple  # noqa: E402
 
 import gymnasium as gym  # noqa: E402
 
 import ballenv  # noqa: E402, F401
 from ballenv.files import write_text  # noqa: E402
+from ballenv.physics.base.jit import kernel  # noqa: E402
 from ballenv.shell import simulate  # noqa: E402
-from ballenv.shell.step import implicit  # noqa: E402
+from ballenv.shell.solve.stepsolve import CG_MAX_ITER  # noqa: E402
+from ballenv.shell.step import implicit, increment  # noqa: E402
 
 RESULTS = pathlib.Path(__file__).parent / "results"
 CASES = (("InflatedBall3D-v0", "pressure"), ("InflatedBall3DPaddle-v0", "paddle"))
@@ -129,23 +135,139 @@ def first_apex(scene, rtol: float, **numerics: float) -> float:
     return float(simulate(run, 1.2).apexes()[0, 1])
 
 
-def rtol_sweep() -> list[tuple[float, float, float, float]]:
-    """(rtol, pressure env steps/s, paddle env steps/s, first-apex error) per ``SWEEP_RTOLS``: the
-    env's step control loosened, against a converged drop (rtol 1e-5, dt 1e-3 s, newton_tol 1e-9)."""
+class Work(NamedTuple):
+    """What the env steps of one run cost: steps/s, and per env step the implicit steps tried (the
+    rejected ones included) and accepted, their Newton and CG iterations and the compiled step's
+    time (ms)."""
+
+    rate: float
+    tried: float
+    accepted: float
+    newton: float
+    cg: float
+    kernel_ms: float
+
+
+def work(env, steps: int, seed: int) -> Work:
+    """The :class:`Work` of ``steps`` random-action env steps of ``env``."""
+    tally = [0, 0, 0, 0.0]  # tries, Newton iterations, CG iterations, seconds
+    kernel = implicit.step_kernel
+
+    def counted(*args):
+        t = time.perf_counter()
+        try:
+            result = kernel(*args)
+        finally:
+            tally[3] += time.perf_counter() - t
+        tally[0] += 1
+        tally[1] += result[1]
+        tally[2] += result[2]
+        return result
+
+    implicit.step_kernel = counted
+    try:
+        rate, accepted, _ = run(env, steps, seed)
+    finally:
+        implicit.step_kernel = kernel
+    tried, newton, cg, seconds = tally
+    return Work(rate, tried / steps, accepted / steps, newton / steps, cg / steps, 1e3 * seconds / steps)
+
+
+def rtol_sweep() -> list[tuple[float, Work, Work, float]]:
+    """(rtol, the pressure env's Work, the paddle env's Work, first-apex error) per ``SWEEP_RTOLS``:
+    the env's step control loosened, against a converged drop (rtol 1e-5, dt 1e-3 s, newton_tol 1e-9)."""
     scene = gym.make(CASES[0][0]).unwrapped.ball.scene
     reference = first_apex(scene, 1e-5, dt=1e-3, newton_tol=1e-9)
     rows = []
     for rtol in SWEEP_RTOLS:
-        rates = []
+        costs = []
         for env_id, _ in CASES:
             env = gym.make(env_id)
             env.unwrapped.ball.scene = dataclasses.replace(env.unwrapped.ball.scene, rtol=rtol)
-            rates.append(run(env, SWEEP_STEPS, 0)[0])
-        rows.append((rtol, rates[0], rates[1], first_apex(scene, rtol) / reference - 1.0))
+            costs.append(work(env, SWEEP_STEPS, 0))
+        rows.append((rtol, costs[0], costs[1], first_apex(scene, rtol) / reference - 1.0))
     return rows
 
 
-def page(rows: dict[str, dict[str, float]], steps: int, scaling: tuple[float, float], sweep) -> str:
+@kernel
+def _gradients(method, st, n):
+    sp, wk = st.start, st.work
+    for _ in range(n):
+        increment.incremental_gradient(method, st, sp, wk.x, wk, wk.grad, wk.blocks)
+    return 0
+
+
+@kernel
+def _potentials(method, st, n):
+    sp, wk = st.start, st.work
+    total = 0.0
+    for _ in range(n):
+        total += increment.incremental(method, st, sp, wk.x, wk)
+    return total
+
+
+@kernel
+def _matrices(st, hinges, n):
+    sp, wk = st.start, st.work
+    for _ in range(n):
+        if hinges:
+            wk.bending_age[0] = -1  # the hinges' matrices are evaluated again, not kept
+        increment.newton_matrix(st, sp, wk.x, wk, True)
+    return 0
+
+
+@kernel
+def _solves(method, st, rtol, n):
+    """``n`` Newton directions at ``wk.x`` on the element matrices already there; their CG
+    iterations."""
+    sp, wk = st.start, st.work
+    iterations = 0
+    for _ in range(n):
+        iterations += increment.direction(st, sp, wk.x, wk.grad, wk.blocks, wk, wk.dx, False, rtol)
+    return iterations
+
+
+def _price(call, *args) -> tuple[float, int]:
+    """(us per call, its result per call) of ``call(*args, n)`` (``n`` calls in one compiled loop),
+    best of 5 repeats of n = 300."""
+    n, best, result = 300, float("inf"), 0
+    call(*args, 1)
+    for _ in range(5):
+        start = time.perf_counter()
+        result = call(*args, n)
+        best = min(best, (time.perf_counter() - start) / n)
+    return 1e6 * best, result / n
+
+
+def part_prices() -> list[tuple[str, float]]:
+    """(part, us) of a Newton iteration of the paddle env's implicit step at 162 vertices."""
+    env = gym.make(CASES[1][0])
+    run(env, 60, 0)
+    sim = env.unwrapped.ball.sim.run
+    method, ref = sim.method, sim.refs[0]
+    implicit.step_kernel(method, ref, sim.x[0], sim.v[0], sim.a[0], 1e-3)  # fills the step's records
+    wk = ref.record.work
+    wk.x[:] = sim.x[0] + 1e-3 * sim.v[0]  # a Newton iterate away from the solution
+    gradient = _price(_gradients, method, ref)[0]
+    phi = _price(_potentials, method, ref)[0]
+    triangles = _price(_matrices, ref, False)[0]
+    with_hinges = _price(_matrices, ref, True)[0]
+    _gradients(method, ref, 1)
+    loose, loose_its = _price(_solves, method, ref, 1e-2)
+    tight, tight_its = _price(_solves, method, ref, 1e-8)
+    per_iteration = (tight - loose) / max(tight_its - loose_its, 1e-9)
+    return [
+        ("the gradient of Phi (with the contact's blocks)", gradient),
+        ("Phi, once per line-search trial", phi),
+        ("the element matrices: the triangles' (the hinges' kept)", triangles),
+        ("the element matrices with the hinges' evaluated again (every 8th fresh assembly)", with_hinges),
+        ("a CG iteration", per_iteration),
+        (f"a solve's set-up (the operator, the preconditioner; {loose_its:.0f} to {tight_its:.0f} "
+         f"of at most {CG_MAX_ITER} iterations measured)", loose - loose_its * per_iteration),
+    ]  # fmt: skip
+
+
+def page(rows: dict[str, dict[str, float]], steps: int, scaling: tuple[float, float], sweep, prices) -> str:
     lines = [
         "# The 3-D ball's envs: throughput",
         "",
@@ -171,19 +293,37 @@ def page(rows: dict[str, dict[str, float]], steps: int, scaling: tuple[float, fl
         "",
         f"Looser step control ({SWEEP_STEPS} env steps each, random actions; first apex of the env's ball",
         "dropped from 1 m against a converged drop) buys little speed for much error, so the env keeps",
-        "the fast preset's rtol = 1e-3:",
+        "the fast preset's rtol = 1e-3. Per env step, for each mode: the implicit steps tried (the",
+        "rejected ones included) and accepted, their Newton and CG iterations, the compiled step's time:",
         "",
-        "| rtol | pressure env steps/s | paddle env steps/s | first-apex error |",
-        "|---:|---:|---:|---:|",
-        *(f"| {r:g} | {p:.0f} | {q:.0f} | {100 * e:+.2f} % |" for r, p, q, e in sweep),
+        "| rtol | mode | env steps/s | steps tried | accepted | Newton iterations | CG iterations "
+        "| implicit step (ms) | first-apex error |",
+        "|---:|---|---:|---:|---:|---:|---:|---:|---:|",
+        *(
+            f"| {r:g} | {mode} | {w.rate:.0f} | {w.tried:.2f} | {w.accepted:.2f} | {w.newton:.2f} "
+            f"| {w.cg:.1f} | {w.kernel_ms:.2f} | {100 * e:+.2f} % |"
+            for r, p, q, e in sweep
+            for mode, w in (("pressure", p), ("paddle", q))
+        ),
+        "",
+        "Longer steps are fewer but each costs more: the mass term `M / h^2` that holds Newton's",
+        "matrix to the last step's motion weakens as `1 / h^2`, so each step takes more Newton",
+        "iterations and each of those more CG iterations. The work per env step changes less than",
+        "the step count.",
+        "",
+        "What the parts of one Newton iteration cost (us, the paddle env's ball in its state after 60",
+        "steps, at 162 vertices, one core):",
+        "",
+        "| part | us |",
+        "|---|---:|",
+        *(f"| {name} | {us:.1f} |" for name, us in prices),
         "",
         "The rest of the time is Python: the step control, events and records between steps, each",
         "compiled call's unpacking of the step's records, and the env's actions, observation and",
-        "reward. The implicit step takes about 0.6-1.3 ms per step tried at 162 vertices. With random",
-        "actions the pressure mode's pumping rings the ball's breathing mode, which the error control",
-        "follows with steps of about a millisecond, most of them in flight; the paddle mode's strikes",
-        "ring it less. A step in contact with friction took 22 Newton iterations before the contact",
-        "vertices' own descent (`ballenv/shell/step/relax.py`), about 5 with it.",
+        "reward. With random actions the pressure mode's pumping rings the ball's breathing mode, which",
+        "the error control follows with steps of about a millisecond, most of them in flight; the",
+        "paddle mode's strikes ring it less. A step in contact with friction took 22 Newton iterations",
+        "before the contact vertices' own descent (`ballenv/shell/step/relax.py`), about 5 with it.",
         "",
     ]
     return "\n".join(lines)
@@ -201,7 +341,9 @@ def main() -> None:
     print("vector, 1 and 2 threads", scaling, flush=True)
     sweep = rtol_sweep()
     print("rtol sweep", sweep, flush=True)
-    write_text(RESULTS / "env3d_throughput.md", page(rows, args.steps, scaling, sweep))
+    prices = part_prices()
+    print("parts", prices, flush=True)
+    write_text(RESULTS / "env3d_throughput.md", page(rows, args.steps, scaling, sweep, prices))
 
 
 if __name__ == "__main__":
