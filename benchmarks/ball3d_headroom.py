@@ -5,6 +5,8 @@ removes when the simulator's future is known.
 
     python benchmarks/ball3d_headroom.py [--episodes 100] [--oracle-episodes 10] [--max-episode-steps 500]
     # writes benchmarks/results/ball3d_headroom.md (about 15 min on 2 cores)
+    python benchmarks/ball3d_headroom.py --target-height-range 0.7 1.0 --start-height-range 0.45 0.65 \
+        --out benchmarks/results/ball3d_headroom_low_start.md   # every start below every target
 
 * **Split.** The dribbler plays each held-out episode (seeds 10,000 on, as ``ball3d_strike.py``
   scores); each apex counts as *before* or *after* its first strike. The paddle strikes a falling
@@ -19,6 +21,9 @@ removes when the simulator's future is known.
   and with each one's error times the oracle's ratio of means, as 3 runs of the same episodes
   (``ball3d_strike.py``'s 3 seeds x 100 episodes), each with its IQM and 95 % stratified bootstrap
   interval (``agents.study``).
+* **Task.** ``--target-height-range`` and ``--start-height-range`` (m) set the env's keywords of
+  those names (the env's defaults otherwise: targets 0.5-1 m, starts 0.6-1.2 m): with every start
+  below every target, no apex is too high before a strike has set it.
 """
 
 import os
@@ -70,14 +75,14 @@ class FirstStrike:
         return action
 
 
-def split(seed: int, steps: int) -> list[tuple[float, float, bool]]:
-    """The dribbler's episode ``seed``: each apex's ``(height error, spot distance m, after its first
-    strike)``, missed apexes included (``agents.evaluate3d``)."""
+def split(seed: int, steps: int, task: dict) -> list[tuple[float, float, bool]]:
+    """The dribbler's episode ``seed`` of the env with keywords ``task``: each apex's ``(height
+    error, spot distance m, after its first strike)``, missed apexes included (``agents.evaluate3d``)."""
     import gymnasium as gym
 
     from agents.evaluate3d import apex_records
 
-    env = gym.make(ENV_ID, max_episode_steps=steps)
+    env = gym.make(ENV_ID, max_episode_steps=steps, **task)
     policy = FirstStrike(env)
     apexes, _, _ = apex_records(env, policy, seed)
     env.close()
@@ -85,14 +90,14 @@ def split(seed: int, steps: int) -> list[tuple[float, float, bool]]:
     return [(a.height, a.distance, first is not None and a.step > first) for a in apexes]
 
 
-def oracle(seed: int, strikes: int, steps: int) -> list[tuple[float, float]]:
+def oracle(seed: int, strikes: int, steps: int, task: dict) -> list[tuple[float, float]]:
     """``(the dribbler's apex error, the best of GRID's)`` at each of the first ``strikes`` strikes of
-    episode ``seed`` (module doc)."""
+    episode ``seed`` of the env with keywords ``task`` (module doc)."""
     import gymnasium as gym
 
     from agents.wrappers3d import PaddleStrike3D
 
-    env = PaddleStrike3D(gym.make(ENV_ID, max_episode_steps=steps))
+    env = PaddleStrike3D(gym.make(ENV_ID, max_episode_steps=steps, **task))
     env.reset(seed=seed)
     rows = []
     for _ in range(strikes):
@@ -136,6 +141,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--oracle-strikes", type=int, default=3, help="strikes probed per episode (default 3)")
     p.add_argument("--max-episode-steps", type=int, default=500, help="time limit (default 500)")
     p.add_argument("--workers", type=int, default=2, help="processes (default 2)")
+    for name in ("target", "start"):
+        p.add_argument(
+            f"--{name}-height-range", type=float, nargs=2, metavar=("LOW", "HIGH"),
+            help=f"the env's {name}_height_range (m; default the env's)",
+        )  # fmt: skip
     p.add_argument("--out", type=pathlib.Path, default=RESULTS / "ball3d_headroom.md")
     return p
 
@@ -145,10 +155,17 @@ def main() -> None:
     start = time.perf_counter()
     seeds = range(SEED, SEED + args.episodes)
     probed = range(SEED, SEED + args.oracle_episodes)
+    task = {
+        f"{name}_height_range": tuple(value)
+        for name in ("target", "start")
+        if (value := getattr(args, f"{name}_height_range")) is not None
+    }
     with ProcessPoolExecutor(args.workers) as pool:
         limit = args.max_episode_steps
-        episodes = list(pool.map(split, seeds, [limit] * len(seeds)))
-        strikes = pool.map(oracle, probed, [args.oracle_strikes] * len(probed), [limit] * len(probed))
+        episodes = list(pool.map(split, seeds, [limit] * len(seeds), [task] * len(seeds)))
+        strikes = pool.map(
+            oracle, probed, [args.oracle_strikes] * len(probed), [limit] * len(probed), [task] * len(probed)
+        )
         probes = np.array([row for rows in strikes for row in rows])
     ratio = float(probes[:, 1].mean() / probes[:, 0].mean())
     dribbler = np.array([combined(rows, 1.0) for rows in episodes])
@@ -158,18 +175,24 @@ def main() -> None:
     apexes = np.mean([len(rows) for rows in episodes])
     share = 1.0 - perfect.sum() / dribbler.sum()
     low = bootstrap_iqm([dribbler])[0]
+    options = "".join(f" --{key.replace('_', '-')} {lo:g} {hi:g}" for key, (lo, hi) in task.items())
+    keywords = ", ".join(f"`{key}={lo:g}-{hi:g} m`" for key, (lo, hi) in task.items())
+    clean = np.mean([all(after for *_, after in rows) for rows in episodes])
     page = [
-        "# The 3-D paddle: what the score leaves to a strike policy",
+        "# The 3-D paddle: what the score leaves to a strike policy" + (f" ({keywords})" if task else ""),
         "",
         f"`python benchmarks/ball3d_headroom.py --episodes {args.episodes} --oracle-episodes "
         f"{args.oracle_episodes} --oracle-strikes {args.oracle_strikes} --max-episode-steps "
-        f"{args.max_episode_steps}`: InflatedBall3DPaddle-v0 (fast preset, 162 vertices), the tuned "
+        f"{args.max_episode_steps}{options}`: InflatedBall3DPaddle-v0 (fast preset, 162 vertices"
+        + (f"; {keywords}" if task else "")
+        + "), the tuned "
         f"dribbler on {args.episodes} held-out episodes (seeds {SEED} on) of at most "
         f"{args.max_episode_steps} control steps; the method is the script's docstring. "
         f"{time.perf_counter() - start:.0f} s on {args.workers} processes.",
         "",
         f"**Split.** {apexes:.2f} apexes an episode, {before:.2f} of them before the dribbler's first "
-        f"strike, which hold {1 - share:.0%} of its combined error (the apexes after it: {share:.0%}).",
+        f"strike, which hold {1 - share:.0%} of its combined error (the apexes after it: {share:.0%}); "
+        f"{clean:.0%} of the episodes have none before it.",
         "",
         f"**Oracle.** {len(probes)} strikes of {args.oracle_episodes} episodes: the combined error of "
         f"the strike's apex {probes[:, 0].mean():.3f} with the dribbler's strike, {probes[:, 1].mean():.3f} "
