@@ -2,6 +2,8 @@
 
     python -m agents.tune heuristic --action-mode pressure --trials 60
     python -m agents.tune heuristic3d --action-mode paddle --trials 30 --episodes 5 --max-episode-steps 400
+    python -m agents.tune heuristic3d --action-mode paddle --trials 30 --episodes 5 --max-episode-steps 400 \
+        --env-kwargs '{"target_height_range": [0.7, 0.9], "start_height_range": [0.55, 0.65]}' --dry-run
     python -m agents.tune ppo --action-mode paddle --trials 12 --timesteps 100000 [train.py options]
     python -m agents.tune ppo --trials 12 --ray local --parallel 2     # trials as Ray tasks
 
@@ -16,7 +18,9 @@ seeds; the held-out seeds of ``agents.evaluate`` (10,000 on) stay unseen.
 * ``heuristic3d``: the 3-D ball's controller (:data:`HEURISTIC3D_SPACE`; paddle mode:
   ``ballenv.controllers.PaddleDribble3D``); objective the mean combined height-and-spot error of
   ``agents.evaluate3d`` over ``--episodes`` episodes seeded 0, 1, ... of ``--max-episode-steps``
-  control steps; the best is written to ``heuristic.yml`` under the 3-D env id, where
+  control steps of the env of ``--env-kwargs`` (default: its own defaults); the first trial is the
+  parameters ``heuristic.yml`` holds (if any), so the best is never worse than them on those
+  episodes. The best is written to ``heuristic.yml`` under the 3-D env id, where
   ``agents.policies.Heuristic3DPolicy`` reads it.
 * ``ppo``: the hyperparameters of :func:`sample_ppo` (the ranges of RL Baselines3 Zoo's PPO
   sampler, narrowed to this budget); each trial trains ``--timesteps`` env steps with
@@ -52,7 +56,7 @@ if TYPE_CHECKING:
 
 from ballenv.files import write_text
 
-from .config import HEURISTIC_PARAMS, heuristic_table, load_hyperparams, task_env_kwargs
+from .config import HEURISTIC_PARAMS, heuristic_table, load_hyperparams, task_env_kwargs, tuned_heuristic3d
 from .evaluate import evaluate
 from .evaluate3d import evaluate3d
 from .policies import Heuristic3DPolicy, HeuristicPolicy
@@ -183,7 +187,11 @@ def tune_heuristic3d(args: argparse.Namespace) -> optuna.Study:
     from ballenv.envs import BALL3D_ENV_IDS
 
     study = optuna.create_study(direction="minimize", sampler=optuna.samplers.TPESampler(seed=args.seed))
-    env_kwargs = {"action_mode": args.action_mode, "max_episode_steps": args.max_episode_steps}
+    task = train_args(args.train_args).env_kwargs or {}  # --env-kwargs, as train.py reads it
+    env_kwargs = {**task, "action_mode": args.action_mode, "max_episode_steps": args.max_episode_steps}
+    tuned = tuned_heuristic3d(args.action_mode)
+    if tuned:
+        study.enqueue_trial(tuned)
 
     def objective(trial: optuna.Trial) -> float:
         params = sample_heuristic(trial, args.action_mode, HEURISTIC3D_SPACE)

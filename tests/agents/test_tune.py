@@ -1,6 +1,7 @@
 """agents.tune: the controllers' and PPO's Optuna searches, on tiny budgets, serially and on a local
 Ray cluster."""
 
+import ast
 import json
 
 import numpy as np
@@ -51,6 +52,16 @@ def test_the_3d_heuristic_search_dry_run_scores_trials_and_leaves_the_file_alone
     assert "best combined error" in out and "spot_distance" in out
     with pytest.raises(SystemExit):
         parse_args([*argv, "--ray", "local"])
+
+
+def test_the_3d_heuristic_search_starts_from_the_tuned_parameters_on_the_task_given(capsys):
+    argv = ["heuristic3d", "--action-mode", "paddle", "--trials", "1", "--episodes", "1"]
+    argv += ["--max-episode-steps", "40", "--dry-run"]
+    main([*argv, "--env-kwargs", json.dumps({"start_height_range": [0.55, 0.65]})])
+    best = ast.literal_eval(capsys.readouterr().out.rsplit("training episodes: ", 1)[1].strip())
+    assert best == tuned_heuristic3d("paddle")  # the only trial: the file's parameters
+    with pytest.raises(ValueError, match="paddle_reach"):  # the keywords reach the env
+        main([*argv, "--env-kwargs", json.dumps({"paddle_reach": -1.0})])
 
 
 def test_ppo_search_trains_trials_and_writes_the_best_in_zoo_format(tmp_path):

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 import yaml
 
+from agents.config import load_hyperparams
 from agents.evaluate3d import evaluate3d, run_episode
 from agents.policies import Heuristic3DPolicy
 from agents.train import parse_args, train
@@ -120,4 +121,35 @@ def test_the_benchmark_says_beat_only_when_the_intervals_are_apart(tmp_path):
     (run / "resume" / "state.json").write_text('{"num_timesteps": 25}')
     lines = bench.curves([run], tmp_path / "curve.png")
     assert lines == ["- `sac_paddle3d_seed4`: 10: 2.0, 20: 5.0; stopped at 25 strikes"]
+    (run / "model.zip").write_bytes(b"")  # a finished run keeps its last periodic state too
+    assert bench.curves([run], tmp_path / "curve.png") == ["- `sac_paddle3d_seed4`: 10: 2.0, 20: 5.0"]
     assert (tmp_path / "curve.png").stat().st_size > 0
+
+
+def test_the_benchmark_scores_every_policy_on_the_runs_task(tmp_path):
+    bench = load_benchmark("ball3d_strike")
+    task = {"target_height_range": [0.7, 0.9], "start_height_range": [0.55, 0.65]}
+    runs = [tmp_path / f"sac_paddle3d_seed{s}" for s in range(3)]
+    for run, kwargs in zip(runs, (task, task, {"start_height_range": [0.5, 0.6]}), strict=True):
+        run.mkdir()
+        (run / "config.yml").write_text(yaml.safe_dump({"env_kwargs": {**kwargs, "action_mode": "paddle"}}))
+    assert bench.run_task(runs[:2]) == task
+    with pytest.raises(ValueError, match="sac_paddle3d_seed2"):
+        bench.run_task(runs)
+    assert bench.task_words(task) == "; `target_height_range=0.7-0.9 m`; `start_height_range=0.55-0.65 m`"
+    assert bench.model_path(runs[0], "final") == runs[0] / "model.zip"
+    assert bench.run_name(bench.model_path(runs[0], "final")) == bench.run_name(runs[0]) == runs[0].name
+
+
+def test_the_reach_task_strikes_before_every_apex():
+    """sac_strike3d_reach.yml's task: every start below every target and already in the paddle's
+    reach on its first fall, so the dribbler's first decision comes before any apex."""
+    kwargs = load_hyperparams("sac", "paddle3d", "sac_strike3d_reach")["env_kwargs"]
+    (low, high), (start_low, start_high) = kwargs["target_height_range"], kwargs["start_height_range"]
+    assert start_high < low
+    env = PaddleStrike3D(gym.make("ballenv:InflatedBall3DPaddle-v0", max_episode_steps=400, **kwargs))
+    c = env.config
+    first_fall = np.sqrt(2.0 * (start_low - c.radius) / abs(c.gravity)) / c.control_dt  # control steps
+    for seed in range(6):
+        _, info = env.reset(seed=seed)
+        assert 0 < env.steps < first_fall and low <= info["target_height"] <= high
