@@ -58,7 +58,7 @@ def test_each_apex_has_its_control_step_and_the_headroom_split_cuts_at_the_first
     steps = [a.step for a in apexes]
     assert steps == sorted(set(steps)) and 0 < steps[0] and steps[-1] <= length == 250
     bench = load_benchmark("ball3d_headroom")
-    rows = bench.split(10_003, 250)
+    rows = bench.split(10_003, 250, {})
     assert [after for *_, after in rows] == [False, False, True]
     assert [(h, d) for h, d, _ in rows] == list(zip(heights, spots, strict=True))
     expected = np.mean(heights) / 0.5 + np.mean(spots) / 0.3
