@@ -77,7 +77,9 @@ def model_path(run: pathlib.Path, model: str) -> pathlib.Path:
 
 def task_words(task: dict[str, Any]) -> str:
     """``task`` as the page's words, e.g. ``; target_height_range=0.7-0.9 m``."""
-    words = [f"{k}={v[0]:g}-{v[1]:g} m" if isinstance(v, list) else f"{k}={v}" for k, v in task.items()]
+    words = [
+        f"{k}={v[0]:g}-{v[1]:g} m" if k.endswith("height_range") else f"{k}={v}" for k, v in task.items()
+    ]
     return "".join(f"; `{w}`" for w in words)
 
 
