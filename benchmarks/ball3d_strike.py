@@ -83,11 +83,6 @@ def task_words(task: dict[str, Any]) -> str:
     return "".join(f"; `{w}`" for w in words)
 
 
-def run_name(policy: pathlib.Path) -> str:
-    """The run folder's name of a scored ``policy`` (a run folder or its ``model.zip``)."""
-    return policy.parent.name if policy.suffix == ".zip" else policy.name
-
-
 def interval(runs: list[tuple[float, ...]]) -> str:
     """``IQM [low, high]`` over the episodes of ``runs`` (a tuple of per-episode values a run)."""
     low, high = bootstrap_iqm([np.asarray(r) for r in runs])
@@ -196,9 +191,9 @@ def main() -> None:
             f"{interval([g[2] for g in group])} | {interval([g[3] for g in group])} | "
             f"{sum(g[4] for g in group):.0f} |"
         )
-    for g in trained:
+    for run, g in zip(args.runs, trained, strict=True):
         rows.append(
-            f"| {run_name(pathlib.Path(g[0]))} | {len(g[1])} | {interval([g[1]])} | {interval([g[2]])} | "
+            f"| {run.name} | {len(g[1])} | {interval([g[1]])} | {interval([g[2]])} | "
             f"{interval([g[3]])} | {g[4]:.0f} |"
         )
     curve_png, clip_mp4 = f"docs/learning_curve_strike3d{suffix}.png", f"docs/figures/strike3d{suffix}.mp4"

@@ -139,7 +139,7 @@ def test_the_benchmark_scores_every_policy_on_the_runs_task(tmp_path):
     assert bench.task_words(task) == "; `target_height_range=0.7-0.9 m`; `start_height_range=0.55-0.65 m`"
     assert bench.task_words({"pressure_range": [2e4, 9e4]}) == "; `pressure_range=[20000.0, 90000.0]`"
     assert bench.model_path(runs[0], "final") == runs[0] / "model.zip"
-    assert bench.run_name(bench.model_path(runs[0], "final")) == bench.run_name(runs[0]) == runs[0].name
+    assert bench.model_path(runs[0], "best") == runs[0]  # the run folder: ModelPolicy takes its best
 
 
 def test_the_reach_task_strikes_before_every_apex():
